@@ -1,0 +1,81 @@
+#include "algorithms/mlp.h"
+
+#include <cmath>
+
+#include "core/error.h"
+
+namespace segue {
+
+Activation parse_activation(const std::string& name) {
+  if (name == "tanh") return Activation::Tanh;
+  if (name == "relu") return Activation::Relu;
+  throw Error("unknown activation '" + name + "' (known: tanh, relu)");
+}
+
+std::string activation_name(Activation a) { return a == Activation::Tanh ? "tanh" : "relu"; }
+
+torch::nn::Sequential make_mlp(int in, const std::vector<int>& hidden, int out, Activation act,
+                               double out_gain) {
+  torch::nn::Sequential net;
+  int width = in;
+  auto add_linear = [&](int to, double gain) {
+    torch::nn::Linear layer(width, to);
+    torch::NoGradGuard no_grad;
+    torch::nn::init::orthogonal_(layer->weight, gain);
+    layer->bias.zero_();
+    net->push_back(layer);
+    width = to;
+  };
+  for (int h : hidden) {
+    add_linear(h, std::sqrt(2.0));
+    if (act == Activation::Tanh) net->push_back(torch::nn::Tanh());
+    else net->push_back(torch::nn::ReLU());
+  }
+  add_linear(out, out_gain);
+  return net;
+}
+
+EigenMlp::EigenMlp(const torch::nn::Sequential& net, Activation act) : act_(act) {
+  for (const auto& module : net->children()) {
+    if (auto* linear = module->as<torch::nn::Linear>()) {
+      auto w = linear->weight.detach().to(torch::kFloat32).contiguous();
+      auto b = linear->bias.detach().to(torch::kFloat32).contiguous();
+      weights_.emplace_back(Eigen::Map<const RowMatrix>(w.data_ptr<float>(), w.size(0), w.size(1)));
+      biases_.emplace_back(Eigen::Map<const Eigen::RowVectorXf>(b.data_ptr<float>(), b.size(0)));
+    }
+  }
+  scratch_.resize(weights_.size());
+}
+
+EigenMlp::EigenMlp(const std::vector<torch::Tensor>& ws, const std::vector<torch::Tensor>& bs,
+                   Activation act)
+    : act_(act) {
+  for (size_t i = 0; i < ws.size(); ++i) {
+    auto w = ws[i].detach().to(torch::kFloat32).contiguous();
+    auto b = bs[i].detach().to(torch::kFloat32).contiguous();
+    if (w.dim() != 2 || b.dim() != 1 || b.size(0) != w.size(0) ||
+        (i > 0 && w.size(1) != ws[i - 1].size(0)))
+      throw Error("layer " + std::to_string(i) + " has inconsistent weight shapes");
+    weights_.emplace_back(Eigen::Map<const RowMatrix>(w.data_ptr<float>(), w.size(0), w.size(1)));
+    biases_.emplace_back(Eigen::Map<const Eigen::RowVectorXf>(b.data_ptr<float>(), b.size(0)));
+  }
+  scratch_.resize(weights_.size());
+}
+
+void EigenMlp::forward(const float* in, int batch, float* out) const {
+  Eigen::Map<const RowMatrix> x(in, batch, in_dim());
+  for (size_t i = 0; i < weights_.size(); ++i) {
+    RowMatrix& y = scratch_[i];
+    y.resize(batch, weights_[i].rows());  // no-op once the batch size is settled
+    if (i == 0) y.noalias() = x * weights_[i].transpose();
+    else y.noalias() = scratch_[i - 1] * weights_[i].transpose();
+    y.rowwise() += biases_[i];
+    if (i + 1 < weights_.size()) {
+      if (act_ == Activation::Tanh) y = y.array().tanh();
+      else y = y.array().max(0.0f);
+    }
+  }
+  Eigen::Map<RowMatrix>(out, batch, out_dim()) = scratch_.back();
+}
+
+}  // namespace segue

@@ -1,0 +1,48 @@
+#pragma once
+// Multi-layer perceptrons, twice: a LibTorch module for training, and an Eigen mirror
+// for per-step inference. A 26-32-32-6 network costs ~2k multiply-adds; a LibTorch call
+// costs far more in dispatch than that, so rollouts run the Eigen copy on the whole
+// batch of environments (checked equal to LibTorch in tests).
+#include <torch/torch.h>
+
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
+namespace segue {
+
+enum class Activation { Tanh, Relu };
+Activation parse_activation(const std::string& name);  // throws segue::Error
+std::string activation_name(Activation a);
+
+// Linear layers in→hidden...→out, `act` between them, none after the last. Hidden layers
+// get orthogonal init with gain sqrt(2); the last layer uses `out_gain` (small for a
+// policy head so initial actions are near zero).
+torch::nn::Sequential make_mlp(int in, const std::vector<int>& hidden, int out, Activation act,
+                               double out_gain);
+
+class EigenMlp {
+ public:
+  using RowMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  EigenMlp() = default;
+  // Copies the Linear layers of `net` (as built by make_mlp).
+  EigenMlp(const torch::nn::Sequential& net, Activation act);
+  // From plain weight tensors W_i [out, in] and biases b_i [out].
+  EigenMlp(const std::vector<torch::Tensor>& weights, const std::vector<torch::Tensor>& biases,
+           Activation act);
+  // in: [batch, in_dim] row-major; out: [batch, out_dim]. Scratch is reused across calls.
+  void forward(const float* in, int batch, float* out) const;
+  int in_dim() const { return weights_.empty() ? 0 : static_cast<int>(weights_.front().cols()); }
+  int out_dim() const { return weights_.empty() ? 0 : static_cast<int>(weights_.back().rows()); }
+  Activation activation() const { return act_; }
+  const std::vector<RowMatrix>& weights() const { return weights_; }
+  const std::vector<Eigen::RowVectorXf>& biases() const { return biases_; }
+
+ private:
+  std::vector<RowMatrix> weights_;  // [out, in]
+  std::vector<Eigen::RowVectorXf> biases_;
+  Activation act_ = Activation::Tanh;
+  mutable std::vector<RowMatrix> scratch_;
+};
+
+}  // namespace segue

@@ -1,0 +1,129 @@
+#include "algorithms/policy.h"
+
+#include <torch/script.h>
+
+#include <algorithm>
+#include <sstream>
+
+#include "algorithms/ppo.h"
+#include "core/error.h"
+#include "core/run_dir.h"
+
+#include <fstream>
+
+namespace segue {
+
+Policy::Policy(EigenMlp mlp, std::vector<float> mean, std::vector<float> inv_std, float clip,
+               std::vector<float> low, std::vector<float> high)
+    : mlp_(std::move(mlp)), obs_mean_(std::move(mean)), obs_inv_std_(std::move(inv_std)),
+      act_low_(std::move(low)), act_high_(std::move(high)), obs_clip_(clip) {}
+
+void Policy::act(const float* obs, int batch, float* actions) const {
+  const int d = obs_dim(), k = act_dim();
+  normalized_.resize(size_t(batch) * d);
+  for (int b = 0; b < batch; ++b)
+    for (int j = 0; j < d; ++j)
+      normalized_[size_t(b) * d + j] =
+          std::clamp((obs[size_t(b) * d + j] - obs_mean_[j]) * obs_inv_std_[j], -obs_clip_, obs_clip_);
+  mlp_.forward(normalized_.data(), batch, actions);
+  for (int b = 0; b < batch; ++b)
+    for (int j = 0; j < k; ++j)
+      actions[size_t(b) * k + j] = std::clamp(actions[size_t(b) * k + j], act_low_[j], act_high_[j]);
+}
+
+void Policy::check_fits(const EnvSpec& spec, const std::string& path) const {
+  if (obs_dim() != spec.obs_dim || act_dim() != spec.act_dim)
+    throw Error(path + ": policy takes obs_dim " + std::to_string(obs_dim()) + " / act_dim " +
+                std::to_string(act_dim()) + ", but task '" + spec.name + "' has obs_dim " +
+                std::to_string(spec.obs_dim) + " / act_dim " + std::to_string(spec.act_dim));
+}
+
+namespace {
+
+torch::Tensor vec(const std::vector<float>& v) {
+  return torch::tensor(v, torch::TensorOptions().dtype(torch::kFloat32));
+}
+template <class M>
+torch::Tensor mat(const M& m) {
+  return torch::from_blob(const_cast<float*>(m.data()), {m.rows(), m.cols()}, torch::kFloat32).clone();
+}
+std::vector<float> to_vec(const torch::Tensor& t) {
+  auto c = t.to(torch::kFloat32).contiguous();
+  return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
+}
+
+}  // namespace
+
+void Policy::export_torchscript(const std::string& path) const {
+  torch::jit::Module m("SeguePolicy");
+  m.register_buffer("obs_mean", vec(obs_mean_));
+  m.register_buffer("obs_inv_std", vec(obs_inv_std_));
+  m.register_buffer("act_low", vec(act_low_));
+  m.register_buffer("act_high", vec(act_high_));
+  m.register_attribute("obs_clip", c10::FloatType::get(), double(obs_clip_));
+  m.register_attribute("n_obs", c10::IntType::get(), int64_t(obs_dim()));
+  m.register_attribute("n_act", c10::IntType::get(), int64_t(act_dim()));
+  m.register_attribute("activation", c10::StringType::get(), activation_name(mlp_.activation()));
+  const size_t layers = mlp_.weights().size();
+  std::ostringstream src;
+  src << "def obs_dim(self) -> int:\n    return self.n_obs\n"
+      << "def act_dim(self) -> int:\n    return self.n_act\n"
+      << "def forward(self, obs: Tensor) -> Tensor:\n"
+      << "    x = torch.clamp((obs - self.obs_mean) * self.obs_inv_std, -self.obs_clip, self.obs_clip)\n";
+  for (size_t i = 0; i < layers; ++i) {
+    m.register_buffer("w" + std::to_string(i), mat(mlp_.weights()[i]));
+    m.register_buffer("b" + std::to_string(i), mat(mlp_.biases()[i]).reshape({-1}));
+    src << "    x = torch.matmul(x, self.w" << i << ".t()) + self.b" << i << "\n";
+    if (i + 1 < layers) src << "    x = torch." << activation_name(mlp_.activation()) << "(x)\n";
+  }
+  src << "    return torch.max(torch.min(x, self.act_high), self.act_low)\n";
+  m.define(src.str());
+  std::ostringstream bytes;
+  m.save(bytes);
+  write_file_atomic(path, bytes.str());
+}
+
+Policy Policy::load_torchscript(const std::string& path) {
+  torch::jit::Module m = torch::jit::load(path);
+  std::vector<torch::Tensor> ws, bs;
+  for (int i = 0; m.hasattr("w" + std::to_string(i)); ++i) {
+    ws.push_back(m.attr("w" + std::to_string(i)).toTensor());
+    bs.push_back(m.attr("b" + std::to_string(i)).toTensor());
+  }
+  if (ws.empty()) throw Error(path + ": not a Segue policy (no layers w0, b0, ...)");
+  Policy p(EigenMlp(ws, bs, parse_activation(m.attr("activation").toStringRef())),
+           to_vec(m.attr("obs_mean").toTensor()), to_vec(m.attr("obs_inv_std").toTensor()),
+           float(m.attr("obs_clip").toDouble()), to_vec(m.attr("act_low").toTensor()),
+           to_vec(m.attr("act_high").toTensor()));
+  // The Eigen forward must be the function the file defines: check on a random batch.
+  torch::manual_seed(0);
+  auto obs = torch::randn({8, p.obs_dim()}) * 3.0;
+  auto expected = m.forward({obs}).toTensor();
+  std::vector<float> got(size_t(8) * p.act_dim());
+  p.act(obs.data_ptr<float>(), 8, got.data());
+  auto diff = (expected - torch::from_blob(got.data(), {8, p.act_dim()})).abs().max().item<float>();
+  if (!(diff < 1e-4f))
+    throw Error(path + ": the TorchScript forward and Segue's reading of its weights differ by " +
+                std::to_string(diff));
+  return p;
+}
+
+Policy Policy::load(const std::string& path) {
+  std::ifstream probe(path);
+  if (!probe) throw Error(path + ": no such policy file");
+  torch::jit::Module m;
+  try {
+    m = torch::jit::load(path);
+  } catch (const c10::Error&) {
+    throw Error(path + ": not a TorchScript policy or Segue checkpoint");
+  }
+  try {
+    if (m.find_method("act_dim")) return load_torchscript(path);
+    return PPO::policy_from_checkpoint(path);
+  } catch (const c10::Error& e) {
+    std::string what = e.what_without_backtrace();
+    throw Error(path + ": unreadable policy: " + what.substr(0, what.find('\n')));
+  }
+}
+
+}  // namespace segue

@@ -1,0 +1,41 @@
+#pragma once
+// A trained policy as a plain function of the observation, for evaluation and for
+// composing skills: a = clamp(mu(clip((s - mean) * inv_std)), low, high). The same
+// function is exported as TorchScript (runnable with torch.jit.load in Python) and read
+// back from it; inference runs the Eigen mirror of the network.
+#include <string>
+#include <vector>
+
+#include "algorithms/mlp.h"
+#include "core/env.h"
+
+namespace segue {
+
+class Policy {
+ public:
+  Policy() = default;
+  Policy(EigenMlp mlp, std::vector<float> obs_mean, std::vector<float> obs_inv_std, float obs_clip,
+         std::vector<float> act_low, std::vector<float> act_high);
+
+  int obs_dim() const { return mlp_.in_dim(); }
+  int act_dim() const { return mlp_.out_dim(); }
+  // obs: [batch, obs_dim] -> actions: [batch, act_dim]. Allocates only when the batch grows.
+  void act(const float* obs, int batch, float* actions) const;
+
+  // Writes a TorchScript module with forward(obs[B, obs_dim]) -> actions[B, act_dim],
+  // obs_dim() and act_dim().
+  void export_torchscript(const std::string& path) const;
+  // Reads an exported .pt or a training checkpoint; throws segue::Error naming the file.
+  static Policy load(const std::string& path);
+  // Refuses a policy whose sizes do not fit the task.
+  void check_fits(const EnvSpec& spec, const std::string& path) const;
+
+ private:
+  static Policy load_torchscript(const std::string& path);
+  EigenMlp mlp_;
+  std::vector<float> obs_mean_, obs_inv_std_, act_low_, act_high_;
+  float obs_clip_ = 10.0f;
+  mutable std::vector<float> normalized_;
+};
+
+}  // namespace segue

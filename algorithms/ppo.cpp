@@ -1,0 +1,326 @@
+#include "algorithms/ppo.h"
+
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "algorithms/gae.h"
+#include "algorithms/ppo_loss.h"
+#include "core/error.h"
+#include "core/run_dir.h"
+
+namespace segue {
+
+PpoConfig PpoConfig::read(const Section& s) {
+  PpoConfig c;
+  c.total_steps = s.get("total_steps", c.total_steps);
+  c.num_envs = s.get("num_envs", c.num_envs);
+  c.steps_per_env = s.get("steps_per_env", c.steps_per_env);
+  c.epochs = s.get("epochs", c.epochs);
+  c.minibatch_size = s.get("minibatch_size", c.minibatch_size);
+  c.lr = s.get("lr", c.lr);
+  c.anneal_lr = s.get("anneal_lr", c.anneal_lr);
+  c.gamma = s.get("gamma", c.gamma);
+  c.lambda = s.get("lambda", c.lambda);
+  c.clip = s.get("clip", c.clip);
+  c.vf_coef = s.get("vf_coef", c.vf_coef);
+  c.ent_coef = s.get("ent_coef", c.ent_coef);
+  c.max_grad_norm = s.get("max_grad_norm", c.max_grad_norm);
+  c.normalize_reward = s.get("normalize_reward", c.normalize_reward);
+  c.obs_clip = s.get("obs_clip", c.obs_clip);
+  if (c.num_envs <= 0) throw s.error("num_envs", "must be positive");
+  if (c.steps_per_env <= 0) throw s.error("steps_per_env", "must be positive");
+  if (c.minibatch_size <= 0) throw s.error("minibatch_size", "must be positive");
+  if (c.epochs <= 0) throw s.error("epochs", "must be positive");
+  if (!(c.lr > 0)) throw s.error("lr", "must be positive");
+  if (!(c.gamma > 0 && c.gamma <= 1)) throw s.error("gamma", "must be in (0, 1]");
+  if (!(c.lambda >= 0 && c.lambda <= 1)) throw s.error("lambda", "must be in [0, 1]");
+  return c;
+}
+
+PPO::PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed)
+    : cfg_(config), envs_(envs), obs_rms_(net.obs_dim, config.obs_clip), return_rms_(1),
+      seed_(seed) {
+  torch::manual_seed(mix_seed(seed, 0x5e9e));
+  net_ = ActorCritic(net);
+  optimizer_ = std::make_unique<torch::optim::Adam>(net_->parameters(),
+                                                     torch::optim::AdamOptions(cfg_.lr).eps(1e-5));
+  buf_.resize(cfg_.steps_per_env, envs.size(), net.obs_dim, net.act_dim);
+  running_return_.assign(envs.size(), 0.0);
+  mean_.resize(size_t(envs.size()) * net.act_dim);
+  envs_.reset(mix_seed(seed, 0));
+  refresh_inference_copy();
+}
+
+int64_t PPO::total_iterations() const {
+  return (cfg_.total_steps + cfg_.rollout_size() - 1) / cfg_.rollout_size();
+}
+
+void PPO::refresh_inference_copy() {
+  actor_copy_ = EigenMlp(net_->actor, net_->spec.activation);
+  auto ls = net_->log_std.detach().contiguous();
+  log_std_.assign(ls.data_ptr<float>(), ls.data_ptr<float>() + ls.numel());
+}
+
+IterationStats PPO::iterate() {
+  IterationStats stats;
+  // Per-iteration seeds make a resumed run draw the same noise as an uninterrupted one.
+  rng_.seed(mix_seed(seed_, 2 * iteration_ + 1));
+  torch::manual_seed(mix_seed(seed_, 2 * iteration_ + 2));
+  auto t0 = std::chrono::steady_clock::now();
+  collect_rollout(stats);
+  auto t1 = std::chrono::steady_clock::now();
+  update(stats);
+  auto t2 = std::chrono::steady_clock::now();
+  stats.rollout_seconds = std::chrono::duration<double>(t1 - t0).count();
+  stats.update_seconds = std::chrono::duration<double>(t2 - t1).count();
+  ++iteration_;
+  global_step_ += cfg_.rollout_size();
+  wall_seconds_ += stats.rollout_seconds + stats.update_seconds;
+  stats.iteration = iteration_;
+  stats.global_step = global_step_;
+  return stats;
+}
+
+void PPO::sample_actions(int t) {
+  const int N = buf_.N, A = buf_.act_dim;
+  float* obs = buf_.obs_at(t);
+  float* act = buf_.actions_at(t);
+  actor_copy_.forward(obs, N, mean_.data());
+  for (int i = 0; i < N; ++i) {
+    float* a = act + size_t(i) * A;
+    const float* mu = &mean_[size_t(i) * A];
+    for (int j = 0; j < A; ++j) a[j] = mu[j] + std::exp(log_std_[j]) * static_cast<float>(rng_.normal());
+    buf_.log_probs[size_t(t) * N + i] = static_cast<float>(gaussian_log_prob(a, mu, log_std_.data(), A));
+  }
+}
+
+void PPO::collect_rollout(IterationStats& stats) {
+  const int T = buf_.T, N = buf_.N, D = buf_.obs_dim;
+  buf_.truncated_index.clear();
+  buf_.truncated_obs.clear();
+  envs_.finished().clear();
+  float ret_sample[1];
+  for (int t = 0; t < T; ++t) {
+    std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf_.raw_obs_at(t));
+    for (int i = 0; i < N; ++i)
+      obs_rms_.normalize(buf_.raw_obs_at(t) + size_t(i) * D, buf_.obs_at(t) + size_t(i) * D);
+    sample_actions(t);
+    envs_.step(buf_.actions_at(t));
+    for (int i = 0; i < N; ++i) {
+      size_t k = size_t(t) * N + i;
+      double r = envs_.reward()[i];
+      bool done = envs_.terminated()[i] || envs_.truncated()[i];
+      buf_.rewards[k] = static_cast<float>(r);
+      buf_.dones[k] = done;
+      running_return_[i] = running_return_[i] * cfg_.gamma + r;
+      ret_sample[0] = static_cast<float>(running_return_[i]);
+      return_rms_.update(ret_sample, 1);
+      if (done) running_return_[i] = 0.0;
+      if (envs_.truncated()[i] && !envs_.terminated()[i]) {
+        buf_.truncated_index.push_back(static_cast<int>(k));
+        buf_.truncated_obs.resize(buf_.truncated_obs.size() + D);
+        obs_rms_.normalize(envs_.final_obs() + size_t(i) * D, &buf_.truncated_obs[buf_.truncated_obs.size() - D]);
+      }
+    }
+  }
+  // Episode statistics, in the task's own reward units.
+  auto& done = envs_.finished();
+  stats.episodes = static_cast<int>(done.size());
+  if (!done.empty()) {
+    double ret = 0, len = 0, succ = 0, count = 0;
+    for (const auto& e : done) ret += e.ret, len += e.length, succ += e.success, count += e.success_count;
+    stats.episode_return = ret / done.size();
+    stats.episode_length = len / done.size();
+    stats.success_rate = succ / done.size();
+    stats.success_count = count / done.size();
+  }
+
+  if (cfg_.normalize_reward) {
+    float scale = static_cast<float>(1.0 / std::sqrt(return_rms_.var()[0] + 1e-8));
+    for (auto& r : buf_.rewards) r = std::clamp(r * scale, -10.0f, 10.0f);
+  }
+  for (float r : buf_.rewards)
+    if (!std::isfinite(r)) throw Error("task '" + envs_.spec().name + "' produced a non-finite reward");
+
+  torch::NoGradGuard no_grad;
+  auto values = net_->value(torch::from_blob(buf_.obs.data(), {int64_t(T) * N, D}));
+  std::copy(values.data_ptr<float>(), values.data_ptr<float>() + values.numel(), buf_.values.begin());
+  std::vector<float> last_obs(size_t(N) * D), last_values(N);
+  for (int i = 0; i < N; ++i) obs_rms_.normalize(envs_.obs() + size_t(i) * D, &last_obs[size_t(i) * D]);
+  auto lv = net_->value(torch::from_blob(last_obs.data(), {N, D}));
+  std::copy(lv.data_ptr<float>(), lv.data_ptr<float>() + N, last_values.begin());
+  // A time limit is not a real end: fold gamma V(final state) into the last reward.
+  if (!buf_.truncated_index.empty()) {
+    int64_t n = static_cast<int64_t>(buf_.truncated_index.size());
+    auto tv = net_->value(torch::from_blob(buf_.truncated_obs.data(), {n, D}));
+    for (int64_t j = 0; j < n; ++j)
+      buf_.rewards[buf_.truncated_index[j]] += static_cast<float>(cfg_.gamma * tv[j].item<float>());
+  }
+  compute_gae(buf_.rewards, buf_.values, buf_.dones, last_values, T, N, cfg_.gamma, cfg_.lambda,
+              buf_.advantages, buf_.returns);
+  // The normaliser learns from this rollout only after the policy has used it.
+  obs_rms_.update(buf_.raw_obs.data(), int64_t(T) * N);
+}
+
+void PPO::update(IterationStats& stats) {
+  const int64_t M = int64_t(buf_.T) * buf_.N;
+  const int64_t mb = std::min<int64_t>(cfg_.minibatch_size, M);
+  if (cfg_.anneal_lr) {
+    double frac = 1.0 - double(iteration_) / double(total_iterations());
+    for (auto& group : optimizer_->param_groups())
+      static_cast<torch::optim::AdamOptions&>(group.options()).lr(cfg_.lr * std::max(frac, 0.0));
+  }
+  auto obs = torch::from_blob(buf_.obs.data(), {M, buf_.obs_dim});
+  auto act = torch::from_blob(buf_.actions.data(), {M, buf_.act_dim});
+  auto old_logp = torch::from_blob(buf_.log_probs.data(), {M});
+  auto adv = torch::from_blob(buf_.advantages.data(), {M});
+  auto ret = torch::from_blob(buf_.returns.data(), {M});
+  int batches = 0;
+  for (int epoch = 0; epoch < cfg_.epochs; ++epoch) {
+    auto perm = torch::randperm(M, torch::kLong);
+    for (int64_t start = 0; start < M; start += mb) {
+      auto idx = perm.slice(0, start, std::min(start + mb, M));
+      auto o = obs.index_select(0, idx);
+      auto a = adv.index_select(0, idx);
+      a = (a - a.mean()) / (a.std() + 1e-8);
+      auto mean = net_->mean(o);
+      auto logp = net_->log_prob(mean, act.index_select(0, idx));
+      auto value = net_->value(o);
+      PpoLoss loss = ppo_loss(logp, old_logp.index_select(0, idx), a, value, ret.index_select(0, idx),
+                              net_->entropy(), cfg_.clip, cfg_.vf_coef, cfg_.ent_coef);
+      optimizer_->zero_grad();
+      loss.total.backward();
+      torch::nn::utils::clip_grad_norm_(net_->parameters(), cfg_.max_grad_norm);
+      optimizer_->step();
+      double total = loss.total.item<double>();
+      if (!std::isfinite(total))
+        throw Error("PPO loss became " + std::to_string(total) + " at iteration " +
+                    std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
+                    "'); the last checkpoint is kept: lower ppo.lr or check the task's rewards");
+      stats.policy_loss += loss.policy.item<double>();
+      stats.value_loss += loss.value.item<double>();
+      stats.approx_kl += loss.approx_kl.item<double>();
+      stats.clip_fraction += loss.clip_fraction.item<double>();
+      ++batches;
+    }
+  }
+  stats.policy_loss /= batches;
+  stats.value_loss /= batches;
+  stats.approx_kl /= batches;
+  stats.clip_fraction /= batches;
+  stats.entropy = net_->entropy().item<double>();
+  refresh_inference_copy();
+}
+
+Policy PPO::policy() const {
+  const auto& spec = envs_.spec();
+  return Policy(actor_copy_, std::vector<float>(obs_rms_.mean().begin(), obs_rms_.mean().end()),
+                obs_rms_.inv_std(), static_cast<float>(obs_rms_.clip()), spec.act_low, spec.act_high);
+}
+
+// ---- checkpoints -------------------------------------------------------------------
+
+namespace {
+
+std::string key(std::string name) {
+  for (auto& c : name)
+    if (c == '.') c = '_';
+  return "ac_" + name;
+}
+torch::Tensor ints(const std::vector<int64_t>& v) { return torch::tensor(v, torch::kLong); }
+std::vector<int> to_ints(const torch::Tensor& t) {
+  std::vector<int> v;
+  for (int64_t i = 0; i < t.numel(); ++i) v.push_back(static_cast<int>(t[i].item<int64_t>()));
+  return v;
+}
+std::vector<int64_t> widen(const std::vector<int>& v) { return {v.begin(), v.end()}; }
+
+}  // namespace
+
+void PPO::save(const std::string& path, const std::string& note) const {
+  torch::serialize::OutputArchive ar;
+  for (const auto& p : net_->named_parameters()) ar.write(key(p.key()), p.value().detach());
+  torch::serialize::OutputArchive opt;
+  optimizer_->save(opt);
+  ar.write("optimizer", opt);
+  obs_rms_.save(ar, "obs_rms_");
+  return_rms_.save(ar, "return_rms_");
+  const auto& s = net_->spec;
+  ar.write("meta_counters", ints({iteration_, global_step_, int64_t(wall_seconds_ * 1000)}));
+  ar.write("meta_dims", ints({s.obs_dim, s.act_dim, s.activation == Activation::Tanh ? 0 : 1}));
+  ar.write("meta_pi_hidden", ints(widen(s.pi_hidden)));
+  ar.write("meta_vf_hidden", ints(widen(s.vf_hidden)));
+  ar.write("meta_act_low", torch::tensor(envs_.spec().act_low));
+  ar.write("meta_act_high", torch::tensor(envs_.spec().act_high));
+  ar.write("meta_note", torch::tensor(std::vector<int64_t>(note.begin(), note.end()), torch::kLong));
+  std::ostringstream bytes;
+  ar.save_to(bytes);
+  write_file_atomic(path, bytes.str());
+}
+
+void PPO::load(const std::string& path) {
+  torch::serialize::InputArchive ar;
+  ar.load_from(path);
+  torch::Tensor dims;
+  ar.read("meta_dims", dims);
+  if (dims[0].item<int64_t>() != net_->spec.obs_dim || dims[1].item<int64_t>() != net_->spec.act_dim)
+    throw Error(path + ": checkpoint sizes do not match the task");
+  torch::NoGradGuard no_grad;
+  for (auto& p : net_->named_parameters()) {
+    torch::Tensor t;
+    ar.read(key(p.key()), t);
+    if (t.sizes() != p.value().sizes())
+      throw Error(path + ": parameter '" + p.key() + "' has another shape than the recipe's network");
+    p.value().copy_(t);
+  }
+  torch::serialize::InputArchive opt;
+  ar.read("optimizer", opt);
+  optimizer_->load(opt);
+  obs_rms_.load(ar, "obs_rms_");
+  return_rms_.load(ar, "return_rms_");
+  torch::Tensor counters;
+  ar.read("meta_counters", counters);
+  iteration_ = counters[0].item<int64_t>();
+  global_step_ = counters[1].item<int64_t>();
+  wall_seconds_ = counters[2].item<int64_t>() / 1000.0;
+  // Episodes in flight at the interruption are lost; start fresh ones, seeded by position.
+  envs_.reset(mix_seed(seed_, 0x10000 + iteration_));
+  running_return_.assign(envs_.size(), 0.0);
+  refresh_inference_copy();
+}
+
+Policy PPO::policy_from_checkpoint(const std::string& path) {
+  torch::serialize::InputArchive ar;
+  ar.load_from(path);
+  torch::Tensor dims, pi, vf, low, high;
+  ar.read("meta_dims", dims);
+  ar.read("meta_pi_hidden", pi);
+  ar.read("meta_vf_hidden", vf);
+  ar.read("meta_act_low", low);
+  ar.read("meta_act_high", high);
+  ActorCriticSpec spec;
+  spec.obs_dim = static_cast<int>(dims[0].item<int64_t>());
+  spec.act_dim = static_cast<int>(dims[1].item<int64_t>());
+  spec.activation = dims[2].item<int64_t>() == 0 ? Activation::Tanh : Activation::Relu;
+  spec.pi_hidden = to_ints(pi);
+  spec.vf_hidden = to_ints(vf);
+  ActorCritic net(spec);
+  torch::NoGradGuard no_grad;
+  for (auto& p : net->named_parameters()) {
+    torch::Tensor t;
+    ar.read(key(p.key()), t);
+    p.value().copy_(t);
+  }
+  RunningMeanStd rms(spec.obs_dim);
+  rms.load(ar, "obs_rms_");
+  auto to_vec = [](const torch::Tensor& t) {
+    auto c = t.to(torch::kFloat32).contiguous();
+    return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
+  };
+  return Policy(EigenMlp(net->actor, spec.activation),
+                std::vector<float>(rms.mean().begin(), rms.mean().end()), rms.inv_std(),
+                static_cast<float>(rms.clip()), to_vec(low), to_vec(high));
+}
+
+}  // namespace segue

@@ -1,0 +1,92 @@
+#pragma once
+// Proximal Policy Optimization with a clipped surrogate (Schulman et al. 2017), in the
+// spirit of CleanRL's single-file PPO: iterate() is one rollout followed by one update,
+// and every piece of state it touches is a member you can see here.
+#include <torch/torch.h>
+
+#include <memory>
+#include <string>
+
+#include "algorithms/actor_critic.h"
+#include "algorithms/policy.h"
+#include "core/recipe.h"
+#include "core/rng.h"
+#include "core/rollout_buffer.h"
+#include "core/running_mean_std.h"
+#include "core/vector_env.h"
+
+namespace segue {
+
+struct PpoConfig {
+  int64_t total_steps = 2'000'000;  // environment (control) steps over the whole run
+  int num_envs = 16;
+  int steps_per_env = 512;          // rollout = num_envs * steps_per_env
+  int epochs = 10;
+  int minibatch_size = 2048;
+  double lr = 3e-4;
+  bool anneal_lr = true;
+  double gamma = 0.99;
+  double lambda = 0.95;
+  double clip = 0.2;
+  double vf_coef = 0.5;
+  double ent_coef = 0.0;
+  double max_grad_norm = 0.5;
+  bool normalize_reward = true;     // scale rewards by the std of the discounted return
+  double obs_clip = 10.0;
+
+  static PpoConfig read(const Section& s);
+  int64_t rollout_size() const { return int64_t(num_envs) * steps_per_env; }
+};
+
+struct IterationStats {
+  int64_t iteration = 0, global_step = 0;
+  int episodes = 0;                 // episodes finished during the rollout
+  double episode_return = NAN, episode_length = NAN, success_rate = NAN, success_count = NAN;
+  double policy_loss = 0, value_loss = 0, entropy = 0, approx_kl = 0, clip_fraction = 0;
+  double rollout_seconds = 0, update_seconds = 0;
+};
+
+class PPO {
+ public:
+  PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed);
+
+  // One rollout of rollout_size() steps, then epochs of minibatch updates.
+  // Throws segue::Error if the loss or the rewards stop being finite.
+  IterationStats iterate();
+  void collect_rollout(IterationStats& stats);
+  void update(IterationStats& stats);
+
+  // The deterministic policy (mean action, normaliser included).
+  Policy policy() const;
+  int64_t iteration() const { return iteration_; }
+  int64_t global_step() const { return global_step_; }
+  double wall_seconds() const { return wall_seconds_; }  // training time, across resumes
+  int64_t total_iterations() const;
+  ActorCritic& net() { return net_; }
+
+  // Checkpoint: network, optimiser, normalisers, counters and `note` (the resolved
+  // recipe), written atomically.
+  void save(const std::string& path, const std::string& note = "") const;
+  void load(const std::string& path);
+  static Policy policy_from_checkpoint(const std::string& path);
+
+ private:
+  void sample_actions(int t);
+  void refresh_inference_copy();
+
+  PpoConfig cfg_;
+  VectorEnv& envs_;
+  ActorCritic net_{nullptr};
+  std::unique_ptr<torch::optim::Adam> optimizer_;
+  EigenMlp actor_copy_;  // Eigen mirror of net_->actor for the rollout
+  RunningMeanStd obs_rms_, return_rms_;
+  RolloutBuffer buf_;
+  Rng rng_;
+  uint64_t seed_;
+  std::vector<double> running_return_;  // discounted return per env, for reward scaling
+  std::vector<float> mean_, log_std_;
+  int64_t iteration_ = 0, global_step_ = 0;
+  double wall_seconds_ = 0.0;
+};
+
+}  // namespace segue

@@ -1,0 +1,23 @@
+#pragma once
+// The pieces of the PPO objective (Schulman et al. 2017), kept apart so each can be
+// checked against hand-computed values.
+#include <torch/torch.h>
+
+namespace segue {
+
+struct PpoLoss {
+  torch::Tensor policy, value, entropy, total;
+  torch::Tensor approx_kl, clip_fraction;  // diagnostics, no gradient
+};
+
+// L^CLIP: mean over the batch of max(-A r, -A clip(r, 1-eps, 1+eps)), r = exp(logp - old).
+torch::Tensor clipped_surrogate(const torch::Tensor& logp, const torch::Tensor& old_logp,
+                                const torch::Tensor& adv, double clip);
+// 0.5 mean (V - R)^2.
+torch::Tensor value_loss(const torch::Tensor& value, const torch::Tensor& returns);
+// total = policy + vf_coef value - ent_coef entropy.
+PpoLoss ppo_loss(const torch::Tensor& logp, const torch::Tensor& old_logp, const torch::Tensor& adv,
+                 const torch::Tensor& value, const torch::Tensor& returns,
+                 const torch::Tensor& entropy, double clip, double vf_coef, double ent_coef);
+
+}  // namespace segue

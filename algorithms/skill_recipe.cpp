@@ -1,0 +1,42 @@
+#include "algorithms/skill_recipe.h"
+
+#include "environments/registry.h"
+
+namespace segue {
+
+SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_run_dir) {
+  Section root = recipe.root();
+  SkillRecipe s;
+  s.task = root.require<std::string>("task");
+  s.seed = root.get<uint64_t>("seed", s.seed);
+  s.threads = root.get("threads", s.threads);
+  s.run_dir = root.get("run_dir", default_run_dir);
+  s.checkpoint_every = root.get("checkpoint_every", s.checkpoint_every);
+  try {
+    s.make_env = task_factory(s.task, root.sub("env"));
+  } catch (const Error& e) {
+    if (std::string(e.what()).rfind("unknown task", 0) == 0) throw root.error("task", e.what());
+    throw;
+  }
+  Section pol = root.sub("policy");
+  s.net.pi_hidden = pol.get("pi_hidden", s.net.pi_hidden);
+  s.net.vf_hidden = pol.get("vf_hidden", s.net.vf_hidden);
+  std::string act = pol.get<std::string>("activation", "tanh");
+  try {
+    s.net.activation = parse_activation(act);
+  } catch (const Error& e) {
+    throw pol.error("activation", e.what());
+  }
+  s.net.init_log_std = pol.get("init_log_std", s.net.init_log_std);
+  s.ppo = PpoConfig::read(root.sub("ppo"));
+  Section ev = root.sub("eval");
+  s.eval_episodes = ev.get("episodes", s.eval_episodes);
+  s.eval_seed = ev.get<uint64_t>("seed", s.eval_seed);
+  if (s.checkpoint_every <= 0) throw root.error("checkpoint_every", "must be positive");
+  auto probe = s.make_env();
+  s.net.obs_dim = probe->spec().obs_dim;
+  s.net.act_dim = probe->spec().act_dim;
+  return s;
+}
+
+}  // namespace segue

@@ -1,0 +1,40 @@
+#pragma once
+// A skill recipe: which task, which network, which PPO settings, where the run lives.
+//
+//   task: walker_forward      # a name from ../shared/spec/environments.md
+//   seed: 1
+//   threads: 0                # 0 = every core
+//   run_dir: runs/walker_forward
+//   checkpoint_every: 5       # iterations
+//   env: {...}                # the task's settings (reference defaults)
+//   policy: {pi_hidden: [32, 32], vf_hidden: [32, 32], activation: tanh, init_log_std: -0.5}
+//   ppo: {...}                # see PpoConfig
+//   eval: {episodes: 50, seed: 1000}
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "algorithms/actor_critic.h"
+#include "algorithms/ppo.h"
+#include "core/recipe.h"
+
+namespace segue {
+
+struct SkillRecipe {
+  std::string task;
+  uint64_t seed = 1;
+  int threads = 0;
+  std::string run_dir;
+  int checkpoint_every = 5;
+  int eval_episodes = 50;
+  uint64_t eval_seed = 1000;
+  std::function<std::unique_ptr<Env>()> make_env;
+  ActorCriticSpec net;
+  PpoConfig ppo;
+
+  // Reads every key (then call recipe.reject_unknown()). `default_run_dir` is used when
+  // the recipe names none.
+  static SkillRecipe read(const Recipe& recipe, const std::string& default_run_dir);
+};
+
+}  // namespace segue

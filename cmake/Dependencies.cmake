@@ -1,0 +1,10 @@
+# Every dependency comes from a Debian 12 package; tools/install_deps.sh installs them.
+find_package(Threads REQUIRED)
+find_package(Torch REQUIRED)          # libtorch-dev
+find_package(mujoco REQUIRED)         # libmujoco-dev (its config needs libqhull-dev)
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+find_package(yaml-cpp REQUIRED)
+find_package(spdlog REQUIRED)
+find_package(GTest)
+# Torch's config appends flags we do not want to force on every target.
+set(CMAKE_CXX_FLAGS "${CMAKE_CXX_FLAGS} ${TORCH_CXX_FLAGS}")

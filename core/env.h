@@ -1,0 +1,54 @@
+#pragma once
+// The environment API. Like EnvPool's env spec: each task declares its shapes up front,
+// and step() writes into caller-owned buffers so a rollout allocates nothing per step.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace segue {
+
+struct EnvSpec {
+  std::string name;
+  int obs_dim = 0;
+  int act_dim = 0;
+  std::vector<float> act_low, act_high;   // action bounds in the environment's units
+  int max_episode_steps = 1000;           // truncation horizon
+  std::vector<std::string> metric_names;  // per-step task metrics reported in StepInfo
+};
+
+constexpr int kMaxMetrics = 4;
+
+struct StepInfo {
+  bool success = false;  // the task's success rule fired (stays true once fired)
+  int success_count = 0; // successes so far this episode (composite tasks count several)
+  std::array<double, kMaxMetrics> metrics{};  // values for EnvSpec::metric_names
+};
+
+struct StepResult {
+  double reward = 0.0;
+  bool terminated = false;  // a true end (fall, contact): no bootstrapping past it
+  bool truncated = false;   // the time limit: the value of the next state still counts
+  StepInfo info;
+  bool done() const { return terminated || truncated; }
+};
+
+class Env {
+ public:
+  virtual ~Env() = default;
+  virtual const EnvSpec& spec() const = 0;
+  // Starts an episode with a fresh random stream drawn from `seed`.
+  virtual void reset(uint64_t seed, float* obs) = 0;
+  // Starts an episode continuing the environment's own random stream.
+  virtual void reset(float* obs) = 0;
+  virtual StepResult step(const float* action, float* obs) = 0;
+
+  // Exact snapshot of everything the next step depends on (physics, task layout, step
+  // counter), flattened to doubles so it can be stored in files. Restoring a snapshot
+  // and stepping reproduces the original run bit for bit; the transition method starts
+  // its episodes from such snapshots of pi_a.
+  virtual void save_state(std::vector<double>& out) const = 0;
+  virtual void restore_state(const std::vector<double>& state, float* obs) = 0;
+};
+
+}  // namespace segue

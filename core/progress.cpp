@@ -1,0 +1,42 @@
+#include "core/progress.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace segue {
+
+std::string format_duration(double s) {
+  if (!std::isfinite(s) || s < 0) return "?";
+  char buf[32];
+  long t = std::lround(s);
+  if (t >= 3600) std::snprintf(buf, sizeof buf, "%ldh%02ldm", t / 3600, (t / 60) % 60);
+  else if (t >= 60) std::snprintf(buf, sizeof buf, "%ldm%02lds", t / 60, t % 60);
+  else std::snprintf(buf, sizeof buf, "%lds", t);
+  return buf;
+}
+
+Progress::Progress(std::string label, long total, long start)
+    : label_(std::move(label)), total_(total), start_(start), tty_(isatty(STDERR_FILENO)),
+      t0_(std::chrono::steady_clock::now()), last_print_(t0_) {}
+
+void Progress::update(long steps, double ret, double success) {
+  auto now = std::chrono::steady_clock::now();
+  double since = std::chrono::duration<double>(now - last_print_).count();
+  if (!tty_ && since < 5.0 && steps < total_) return;
+  last_print_ = now;
+  double elapsed = std::chrono::duration<double>(now - t0_).count();
+  double sps = elapsed > 0 ? (steps - start_) / elapsed : 0.0;
+  double eta = sps > 0 ? (total_ - steps) / sps : NAN;
+  std::fprintf(stderr, "%s[%s] step %ld/%ld (%.0f%%)  %.0f steps/s  return %.1f  success %.0f%%  ETA %s%s",
+               tty_ ? "\r\033[K" : "", label_.c_str(), steps, total_, 100.0 * steps / total_, sps,
+               ret, 100.0 * success, format_duration(eta).c_str(), tty_ ? "" : "\n");
+  std::fflush(stderr);
+}
+
+void Progress::finish() {
+  if (tty_) std::fprintf(stderr, "\n");
+}
+
+}  // namespace segue

@@ -1,0 +1,24 @@
+#pragma once
+// The console progress line: steps, steps/s, recent return, ETA. Redrawn in place on a
+// terminal, printed as plain lines (at most every few seconds) into logs.
+#include <chrono>
+#include <string>
+
+namespace segue {
+
+class Progress {
+ public:
+  Progress(std::string label, long total_steps, long start_steps = 0);
+  void update(long steps, double recent_return, double success_rate);
+  void finish();
+
+ private:
+  std::string label_;
+  long total_, start_;
+  bool tty_;
+  std::chrono::steady_clock::time_point t0_, last_print_;
+};
+
+std::string format_duration(double seconds);
+
+}  // namespace segue

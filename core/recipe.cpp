@@ -1,0 +1,168 @@
+#include "core/recipe.h"
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+
+namespace segue {
+
+template <> const char* type_name<double>() { return "a number"; }
+template <> const char* type_name<float>() { return "a number"; }
+template <> const char* type_name<int>() { return "an integer"; }
+template <> const char* type_name<int64_t>() { return "an integer"; }
+template <> const char* type_name<uint64_t>() { return "a non-negative integer"; }
+template <> const char* type_name<bool>() { return "true or false"; }
+template <> const char* type_name<std::string>() { return "a string"; }
+template <> const char* type_name<std::vector<int>>() { return "a list of integers"; }
+template <> const char* type_name<std::vector<double>>() { return "a list of numbers"; }
+template <> const char* type_name<std::vector<std::string>>() { return "a list of strings"; }
+
+namespace {
+
+std::vector<std::string> split_key(const std::string& key) {
+  std::vector<std::string> parts;
+  std::stringstream ss(key);
+  for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
+  return parts;
+}
+
+// Edit distance, to suggest the key a typo meant.
+size_t distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diag = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] != b[j - 1])});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+
+void set_path(YAML::Node root, const std::vector<std::string>& parts, const YAML::Node& value) {
+  // yaml-cpp nodes are handles: walk down by reassigning a handle copy.
+  std::vector<YAML::Node> chain{root};
+  for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    YAML::Node next = chain.back()[parts[i]];
+    if (!next.IsDefined() || !next.IsMap()) {
+      chain.back()[parts[i]] = YAML::Node(YAML::NodeType::Map);
+      next = chain.back()[parts[i]];
+    }
+    chain.push_back(next);
+  }
+  chain.back()[parts.back()] = value;
+}
+
+void collect_leaves(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& out) {
+  if (node.IsMap() && node.size() > 0) {
+    for (const auto& kv : node)
+      collect_leaves(kv.second, prefix.empty() ? kv.first.as<std::string>()
+                                               : prefix + "." + kv.first.as<std::string>(), out);
+  } else if (!prefix.empty()) {  // an empty document has no keys
+    out.push_back(prefix);
+  }
+}
+
+}  // namespace
+
+std::optional<YAML::Node> Section::lookup(const std::string& full_key) const {
+  // reset() rebinds a handle; operator= would overwrite the node it points at.
+  YAML::Node node;
+  node.reset(s_->tree);
+  for (const auto& part : split_key(full_key)) {
+    if (!node.IsMap()) return std::nullopt;
+    const YAML::Node& map = node;
+    YAML::Node child = map[part];
+    if (!child.IsDefined() || child.IsNull()) return std::nullopt;
+    node.reset(child);
+  }
+  return node;
+}
+
+void Section::record(const std::string& full_key, const YAML::Node& value) const {
+  s_->read.insert(full_key);
+  set_path(s_->resolved, split_key(full_key), value);
+}
+
+bool Section::has(const std::string& key) const { return lookup(full(key)).has_value(); }
+
+Section Section::sub(const std::string& key) const {
+  std::string k = full(key);
+  auto node = lookup(k);
+  if (node && !node->IsMap())
+    throw Error(s_->file + ": key '" + k + "' should be a mapping of keys");
+  s_->read.insert(k);  // an empty section is fine
+  return Section(s_, k);
+}
+
+Error Section::error(const std::string& key, const std::string& msg) const {
+  return Error(s_->file + ": key '" + full(key) + "': " + msg);
+}
+
+Recipe Recipe::parse(const std::string& text, const std::string& name,
+                     const std::vector<std::string>& overrides) {
+  auto s = std::make_shared<Section::State>();
+  s->file = name;
+  try {
+    s->tree = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw Error(name + ": malformed YAML at line " + std::to_string(e.mark.line + 1) + ": " + e.msg);
+  }
+  if (s->tree.IsNull()) s->tree = YAML::Node(YAML::NodeType::Map);
+  if (!s->tree.IsMap()) throw Error(name + ": a recipe must be a mapping of keys");
+  s->resolved = YAML::Node(YAML::NodeType::Map);
+  for (const auto& o : overrides) {
+    auto eq = o.find('=');
+    if (eq == std::string::npos || eq == 0)
+      throw Error("--set " + o + ": expected key=value");
+    std::string key = o.substr(0, eq);
+    YAML::Node value;
+    try {
+      value = YAML::Load(o.substr(eq + 1));
+    } catch (const YAML::Exception& e) {
+      throw Error("--set " + o + ": malformed value: " + e.msg);
+    }
+    set_path(s->tree, split_key(key), value);
+    s->overridden.insert(key);
+  }
+  return Recipe(s);
+}
+
+Recipe Recipe::load(const std::string& file, const std::vector<std::string>& overrides) {
+  std::ifstream in(file);
+  if (!in) throw Error(file + ": cannot read recipe (no such file?)");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parse(ss.str(), file, overrides);
+}
+
+Section Recipe::root() const { return Section(s_, ""); }
+const std::string& Recipe::file() const { return s_->file; }
+
+void Recipe::reject_unknown() const {
+  std::vector<std::string> leaves;
+  collect_leaves(s_->tree, "", leaves);
+  for (const auto& leaf : leaves) {
+    if (s_->read.count(leaf)) continue;
+    std::string best;
+    size_t best_d = 4;
+    for (const auto& known : s_->read) {
+      size_t d = distance(leaf, known);
+      if (d < best_d) best_d = d, best = known;
+    }
+    std::string origin = s_->overridden.count(leaf) ? " (from --set)" : "";
+    throw Error(s_->file + ": unknown key '" + leaf + "'" + origin +
+                (best.empty() ? "" : "; did you mean '" + best + "'?"));
+  }
+}
+
+std::string Recipe::resolved_yaml() const {
+  YAML::Emitter e;
+  e << s_->resolved;
+  return std::string(e.c_str()) + "\n";
+}
+
+}  // namespace segue

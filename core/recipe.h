@@ -1,0 +1,114 @@
+#pragma once
+// YAML recipes with strict key checking. Code declares the keys it understands by
+// reading them (with a default, or required); after everything is read,
+// reject_unknown() refuses any key nobody read, which catches typos like "ppo.lrr".
+// The values actually used, defaults included, form the resolved recipe that a run
+// directory records.
+#include <yaml-cpp/yaml.h>
+
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+
+namespace segue {
+
+class Recipe;
+
+// A view of one mapping inside a recipe, e.g. the "ppo" section.
+class Section {
+ public:
+  template <class T>
+  T get(const std::string& key, const T& fallback) const;
+  template <class T>
+  T require(const std::string& key) const;
+  bool has(const std::string& key) const;
+  Section sub(const std::string& key) const;
+  const std::string& path() const { return prefix_; }
+  // "FILE: key 'a.b': msg" — the one-line error for a bad value found after reading.
+  Error error(const std::string& key, const std::string& msg) const;
+
+ private:
+  friend class Recipe;
+  struct State;
+  Section(std::shared_ptr<State> s, std::string prefix) : s_(std::move(s)), prefix_(std::move(prefix)) {}
+  std::string full(const std::string& key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
+  std::optional<YAML::Node> lookup(const std::string& full_key) const;
+  template <class T>
+  T convert(const YAML::Node& node, const std::string& full_key) const;
+  void record(const std::string& full_key, const YAML::Node& value) const;
+  std::shared_ptr<State> s_;
+  std::string prefix_;
+};
+
+class Recipe {
+ public:
+  // Loads FILE and applies "key=value" overrides (values parsed as YAML).
+  static Recipe load(const std::string& file, const std::vector<std::string>& overrides = {});
+  static Recipe parse(const std::string& yaml_text, const std::string& name,
+                      const std::vector<std::string>& overrides = {});
+  Section root() const;
+  const std::string& file() const;
+  void reject_unknown() const;
+  // The values read so far, defaults included, as YAML text.
+  std::string resolved_yaml() const;
+
+ private:
+  explicit Recipe(std::shared_ptr<Section::State> s) : s_(std::move(s)) {}
+  std::shared_ptr<Section::State> s_;
+};
+
+struct Section::State {
+  std::string file;
+  YAML::Node tree;
+  YAML::Node resolved;
+  std::set<std::string> read;
+  std::set<std::string> overridden;
+};
+
+template <class T>
+T Section::get(const std::string& key, const T& fallback) const {
+  std::string k = full(key);
+  auto node = lookup(k);
+  T value = node ? convert<T>(*node, k) : fallback;
+  record(k, YAML::Node(value));
+  return value;
+}
+
+template <class T>
+T Section::require(const std::string& key) const {
+  std::string k = full(key);
+  auto node = lookup(k);
+  if (!node) throw Error(s_->file + ": missing required key '" + k + "'");
+  T value = convert<T>(*node, k);
+  record(k, YAML::Node(value));
+  return value;
+}
+
+// Type names for messages.
+template <class T> const char* type_name();
+
+template <class T>
+T Section::convert(const YAML::Node& node, const std::string& k) const {
+  auto bad = [&]() {
+    YAML::Emitter e;
+    e << YAML::Flow << node;
+    return Error(s_->file + ": key '" + k + "' expects " + type_name<T>() + ", got '" +
+                 e.c_str() + "'");
+  };
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    // Accept 2e6 for an integer: step budgets are naturally written that way.
+    if (!node.IsScalar()) throw bad();
+    double d;
+    try { d = node.as<double>(); } catch (const YAML::Exception&) { throw bad(); }
+    if (d != static_cast<double>(static_cast<T>(d))) throw bad();
+    return static_cast<T>(d);
+  } else {
+    try { return node.as<T>(); } catch (const YAML::Exception&) { throw bad(); }
+  }
+}
+
+}  // namespace segue

@@ -1,0 +1,42 @@
+#pragma once
+// On-policy storage for one PPO rollout, time-major [T, N, ...]. Sized once; refilled
+// every iteration without allocating.
+#include <cstdint>
+#include <vector>
+
+namespace segue {
+
+struct RolloutBuffer {
+  int T = 0, N = 0, obs_dim = 0, act_dim = 0;
+  std::vector<float> obs;       // normalised observations the policy saw  [T, N, obs_dim]
+  std::vector<float> raw_obs;   // the same before normalisation (for the normaliser)
+  std::vector<float> actions;   // sampled, unclipped                       [T, N, act_dim]
+  std::vector<float> log_probs; // log pi_old(a|s)                          [T, N]
+  std::vector<float> rewards;   // [T, N]
+  std::vector<uint8_t> dones;   // episode ended at this step              [T, N]
+  std::vector<float> values, advantages, returns;  // [T, N]
+  // Truncated steps: their index t*N+n and the (normalised) final observation to bootstrap.
+  std::vector<int> truncated_index;
+  std::vector<float> truncated_obs;
+
+  void resize(int t, int n, int od, int ad) {
+    T = t, N = n, obs_dim = od, act_dim = ad;
+    size_t steps = size_t(t) * n;
+    obs.resize(steps * od);
+    raw_obs.resize(steps * od);
+    actions.resize(steps * ad);
+    log_probs.resize(steps);
+    rewards.resize(steps);
+    dones.resize(steps);
+    values.resize(steps);
+    advantages.resize(steps);
+    returns.resize(steps);
+    truncated_index.reserve(steps);
+    truncated_obs.reserve(steps * od);
+  }
+  float* obs_at(int t) { return &obs[size_t(t) * N * obs_dim]; }
+  float* raw_obs_at(int t) { return &raw_obs[size_t(t) * N * obs_dim]; }
+  float* actions_at(int t) { return &actions[size_t(t) * N * act_dim]; }
+};
+
+}  // namespace segue

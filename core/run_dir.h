@@ -1,0 +1,40 @@
+#pragma once
+// A run directory: the resolved recipe it was started with, metrics.csv (one row per
+// iteration), and checkpoints. Files are replaced atomically (write, fsync, rename), so
+// a run killed at any moment leaves either the old checkpoint or the new one.
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace segue {
+
+// Writes `bytes` to `path` via a temporary file and rename().
+void write_file_atomic(const std::string& path, const std::string& bytes);
+std::string read_file(const std::string& path);
+
+// Appends rows to a CSV whose header is fixed by the first call. On resume, rows past
+// the checkpointed iteration are dropped so the file matches the restored state.
+class MetricsCsv {
+ public:
+  MetricsCsv(const std::string& path, const std::vector<std::string>& columns, long keep_rows);
+  void write(const std::vector<double>& values);
+
+ private:
+  std::string path_;
+  std::ofstream out_;
+};
+
+class RunDir {
+ public:
+  // Opens or creates DIR. A DIR holding a different resolved recipe is refused.
+  RunDir(const std::string& dir, const std::string& resolved_recipe);
+  const std::string& path() const { return dir_; }
+  std::string file(const std::string& name) const { return dir_ + "/" + name; }
+  std::string checkpoint() const { return file("checkpoint.pt"); }
+  bool has_checkpoint() const;
+
+ private:
+  std::string dir_;
+};
+
+}  // namespace segue

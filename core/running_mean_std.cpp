@@ -1,0 +1,74 @@
+#include "core/running_mean_std.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace segue {
+
+RunningMeanStd::RunningMeanStd(int dim, double clip, double eps)
+    : mean_(dim, 0.0), var_(dim, 1.0), clip_(clip), eps_(eps) {
+  refresh();
+}
+
+void RunningMeanStd::update(const float* rows, int64_t n) {
+  if (n <= 0) return;
+  const int d = dim();
+  std::vector<double>& bmean = batch_mean_;
+  std::vector<double>& bvar = batch_var_;
+  bmean.assign(d, 0.0);
+  bvar.assign(d, 0.0);
+  for (int64_t r = 0; r < n; ++r)
+    for (int j = 0; j < d; ++j) bmean[j] += rows[r * d + j];
+  for (int j = 0; j < d; ++j) bmean[j] /= n;
+  for (int64_t r = 0; r < n; ++r)
+    for (int j = 0; j < d; ++j) {
+      double c = rows[r * d + j] - bmean[j];
+      bvar[j] += c * c;
+    }
+  for (int j = 0; j < d; ++j) bvar[j] /= n;
+  // Merge (count_, mean_, var_) with (n, bmean, bvar).
+  double total = count_ + n;
+  for (int j = 0; j < d; ++j) {
+    double delta = bmean[j] - mean_[j];
+    double m2 = var_[j] * count_ + bvar[j] * n + delta * delta * count_ * n / total;
+    mean_[j] += delta * n / total;
+    var_[j] = m2 / total;
+  }
+  count_ = total;
+  refresh();
+}
+
+void RunningMeanStd::refresh() {
+  mean_f_.assign(mean_.begin(), mean_.end());
+  inv_std_.resize(mean_.size());
+  for (size_t j = 0; j < mean_.size(); ++j)
+    inv_std_[j] = static_cast<float>(1.0 / std::sqrt(var_[j] + eps_));
+}
+
+void RunningMeanStd::normalize(const float* in, float* out) const {
+  const float c = static_cast<float>(clip_);
+  for (size_t j = 0; j < mean_f_.size(); ++j)
+    out[j] = std::clamp((in[j] - mean_f_[j]) * inv_std_[j], -c, c);
+}
+
+void RunningMeanStd::save(torch::serialize::OutputArchive& ar, const std::string& p) const {
+  auto opts = torch::TensorOptions().dtype(torch::kFloat64);
+  ar.write(p + "mean", torch::tensor(mean_, opts));
+  ar.write(p + "var", torch::tensor(var_, opts));
+  ar.write(p + "count", torch::tensor({count_, clip_, eps_}, opts));
+}
+
+void RunningMeanStd::load(torch::serialize::InputArchive& ar, const std::string& p) {
+  torch::Tensor m, v, c;
+  ar.read(p + "mean", m);
+  ar.read(p + "var", v);
+  ar.read(p + "count", c);
+  mean_.assign(m.data_ptr<double>(), m.data_ptr<double>() + m.numel());
+  var_.assign(v.data_ptr<double>(), v.data_ptr<double>() + v.numel());
+  count_ = c[0].item<double>();
+  clip_ = c[1].item<double>();
+  eps_ = c[2].item<double>();
+  refresh();
+}
+
+}  // namespace segue

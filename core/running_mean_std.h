@@ -1,0 +1,38 @@
+#pragma once
+// Running mean and variance of observations (Chan et al.'s parallel update), used to
+// normalise policy inputs: x' = clip((x - mean) / sqrt(var + eps), -clip, clip).
+// The statistics travel with the policy (checkpoint and TorchScript export).
+#include <torch/torch.h>
+
+#include <vector>
+
+namespace segue {
+
+class RunningMeanStd {
+ public:
+  explicit RunningMeanStd(int dim = 0, double clip = 10.0, double eps = 1e-8);
+  // Adds a batch of `n` rows of length dim().
+  void update(const float* rows, int64_t n);
+  void normalize(const float* in, float* out) const;
+  int dim() const { return static_cast<int>(mean_.size()); }
+  double count() const { return count_; }
+  const std::vector<double>& mean() const { return mean_; }
+  const std::vector<double>& var() const { return var_; }
+  double clip() const { return clip_; }
+  double eps() const { return eps_; }
+  // 1 / sqrt(var + eps), cached so normalize() is a multiply.
+  const std::vector<float>& inv_std() const { return inv_std_; }
+
+  void save(torch::serialize::OutputArchive& ar, const std::string& prefix) const;
+  void load(torch::serialize::InputArchive& ar, const std::string& prefix);
+
+ private:
+  void refresh();
+  std::vector<double> batch_mean_, batch_var_;  // scratch: update() allocates nothing
+  std::vector<double> mean_, var_;
+  std::vector<float> mean_f_, inv_std_;
+  double count_ = 0.0;
+  double clip_, eps_;
+};
+
+}  // namespace segue

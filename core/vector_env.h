@@ -1,0 +1,60 @@
+#pragma once
+// N environments stepped together on a thread pool. Buffers are laid out row-major
+// ([N, obs_dim]) so a policy can run once on the whole batch. An environment that
+// finishes an episode is reset at once; the observation it ended on is kept in
+// final_obs() (a truncated episode is bootstrapped from it) and the episode's totals
+// are queued for the caller.
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "core/env.h"
+#include "core/thread_pool.h"
+
+namespace segue {
+
+struct EpisodeStats {
+  double ret = 0.0;
+  int length = 0;
+  bool success = false;
+  int success_count = 0;
+  std::array<double, kMaxMetrics> metric_sums{};  // per-step metrics summed over the episode
+};
+
+class VectorEnv {
+ public:
+  using Factory = std::function<std::unique_ptr<Env>()>;
+  VectorEnv(const Factory& make, int num_envs, int threads);
+
+  int size() const { return static_cast<int>(envs_.size()); }
+  const EnvSpec& spec() const { return envs_[0]->spec(); }
+  Env& env(int i) { return *envs_[i]; }
+  // Seeds environment i from mix_seed(seed, i) and resets all of them.
+  void reset(uint64_t seed);
+  // Applies actions [N, act_dim]; afterwards obs(), reward(), terminated(), truncated()
+  // describe the step and finished episodes are appended to finished().
+  void step(const float* actions);
+
+  const float* obs() const { return obs_.data(); }
+  const float* final_obs() const { return final_obs_.data(); }
+  const std::vector<double>& reward() const { return reward_; }
+  const std::vector<uint8_t>& terminated() const { return terminated_; }
+  const std::vector<uint8_t>& truncated() const { return truncated_; }
+  const std::vector<StepInfo>& info() const { return info_; }
+  std::vector<EpisodeStats>& finished() { return finished_; }
+  ThreadPool& pool() { return pool_; }
+
+ private:
+  std::vector<std::unique_ptr<Env>> envs_;
+  ThreadPool pool_;
+  int obs_dim_, act_dim_;
+  std::vector<float> obs_, final_obs_;
+  std::vector<double> reward_;
+  std::vector<uint8_t> terminated_, truncated_;
+  std::vector<StepInfo> info_;
+  std::vector<EpisodeStats> running_, finished_;
+  std::function<void(int, int)> step_block_;
+  const float* actions_ = nullptr;
+};
+
+}  // namespace segue

@@ -1,0 +1,18 @@
+#pragma once
+// Task names (../shared/spec/environments.md) to environment constructors. A task's
+// parameters come from the recipe's `env:` section; every key has the reference default.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/env.h"
+#include "core/recipe.h"
+
+namespace segue {
+
+// Reads the task's settings from `env` (so unknown keys can be refused afterwards) and
+// returns a factory for independent copies. Throws segue::Error for an unknown task.
+std::function<std::unique_ptr<Env>()> task_factory(const std::string& task, const Section& env);
+std::vector<std::string> task_names();
+
+}  // namespace segue

@@ -1,0 +1,106 @@
+#include "environments/walker.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace segue {
+
+WalkerConfig WalkerConfig::read(const Section& s) {
+  WalkerConfig c;
+  c.max_episode_steps = s.get("max_episode_steps", c.max_episode_steps);
+  c.success_steps = s.get("success_steps", c.success_steps);
+  c.init_noise = s.get("init_noise", c.init_noise);
+  c.init_random_steps = s.get("init_random_steps", c.init_random_steps);
+  c.push_prob = s.get("push_prob", c.push_prob);
+  c.push_force = s.get("push_force", c.push_force);
+  c.fall_height = s.get("fall_height", c.fall_height);
+  c.target_speed = s.get("target_speed", c.target_speed);
+  c.height_target = s.get("height_target", c.height_target);
+  c.upright_weight = s.get("upright_weight", c.upright_weight);
+  c.alive_bonus = s.get("alive_bonus", c.alive_bonus);
+  c.foot_cost = s.get("foot_cost", c.foot_cost);
+  c.ctrl_cost = s.get("ctrl_cost", c.ctrl_cost);
+  if (c.max_episode_steps <= 0) throw s.error("max_episode_steps", "must be positive");
+  if (c.push_prob < 0 || c.push_prob > 1) throw s.error("push_prob", "must be in [0, 1]");
+  return c;
+}
+
+WalkerEnv::WalkerEnv(const std::string& name, const WalkerConfig& config)
+    : MujocoEnv("walker/walker.xml", 4), cfg_(config) {
+  spec_.name = name;
+  spec_.obs_dim = kBaseObsDim;
+  spec_.max_episode_steps = cfg_.max_episode_steps;
+  spec_.metric_names = {"x_velocity"};
+  qx_ = joint_qpos("rootx");
+  qz_ = joint_qpos("rootz");
+  qpitch_ = joint_qpos("rooty");
+  torso_ = body_id("torso");
+  foot_ = body_id("foot");
+  foot_left_ = body_id("foot_left");
+  foot_dof_ = model_->jnt_dofadr[mj_name2id(model_, mjOBJ_JOINT, "foot_joint")];
+  foot_left_dof_ = model_->jnt_dofadr[mj_name2id(model_, mjOBJ_JOINT, "foot_left_joint")];
+}
+
+double WalkerEnv::delta_h() const {
+  return data_->xpos[3 * torso_ + 2] -
+         std::max(data_->xpos[3 * foot_ + 2], data_->xpos[3 * foot_left_ + 2]);
+}
+
+double WalkerEnv::min_x() const {
+  return std::min({data_->xpos[3 * torso_], data_->xpos[3 * foot_], data_->xpos[3 * foot_left_]});
+}
+
+void WalkerEnv::reset_task() {
+  for (int i = 0; i < model_->nq; ++i) data_->qpos[i] = model_->qpos0[i] + rng_.symmetric(cfg_.init_noise);
+  for (int i = 0; i < model_->nv; ++i) data_->qvel[i] = rng_.symmetric(cfg_.init_noise);
+  // A few random actions, so episodes do not all start from one pose.
+  std::vector<float> a(model_->nu);
+  for (int k = 0; k < cfg_.init_random_steps; ++k) {
+    for (auto& x : a) x = static_cast<float>(rng_.symmetric(1.0));
+    simulate(a.data());
+  }
+  x_before_ = torso_x();
+}
+
+void WalkerEnv::before_physics() {
+  x_before_ = torso_x();
+  // A push lasts one control step.
+  std::fill(data_->xfrc_applied, data_->xfrc_applied + 6 * model_->nbody, 0.0);
+  if (cfg_.push_prob > 0 && rng_.bernoulli(cfg_.push_prob)) {
+    int body = rng_.integer(1, model_->nbody - 1);
+    data_->xfrc_applied[6 * body] = rng_.symmetric(cfg_.push_force);
+  }
+}
+
+void WalkerEnv::observe(float* obs) const {
+  const mjModel* m = model_;
+  int k = 0;
+  for (int i = 1; i < m->nq; ++i) obs[k++] = static_cast<float>(data_->qpos[i]);
+  for (int i = 0; i < m->nv; ++i) obs[k++] = static_cast<float>(std::clamp(data_->qvel[i], -10.0, 10.0));
+  for (int i = 0; i < m->nv; ++i) obs[k++] = static_cast<float>(data_->qacc[i]);
+}
+
+double WalkerEnv::posture_terms(const float* a) const {
+  double ctrl = 0.0;
+  for (int i = 0; i < model_->nu; ++i) ctrl += double(a[i]) * a[i];
+  double foot = std::abs(data_->qvel[foot_dof_]) + std::abs(data_->qvel[foot_left_dof_]);
+  return cfg_.upright_weight * std::cos(pitch()) + cfg_.alive_bonus - cfg_.foot_cost * foot -
+         cfg_.ctrl_cost * ctrl;
+}
+
+WalkerWalk::WalkerWalk(const std::string& name, const WalkerConfig& config, double direction)
+    : WalkerEnv(name, config), direction_(direction) {}
+
+StepResult WalkerWalk::evaluate(const float* action) {
+  StepResult r;
+  double v = x_velocity();
+  r.reward = speed_term(direction_ * v) - std::abs(cfg_.height_target - delta_h()) + posture_terms(action);
+  r.terminated = fallen();
+  r.info.success = !r.terminated && t_ >= cfg_.success_steps;
+  r.info.success_count = r.info.success ? 1 : 0;
+  r.info.metrics[0] = v;
+  if (r.info.success) r.truncated = true;
+  return r;
+}
+
+}  // namespace segue

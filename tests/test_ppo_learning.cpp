@@ -1,0 +1,81 @@
+// PPO learns: on a short walker horizon, a fixed-seed run improves the deterministic
+// policy's return; and an interrupted run resumes from its checkpoint.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "algorithms/evaluate.h"
+#include "algorithms/ppo.h"
+#include "environments/registry.h"
+
+namespace segue {
+namespace {
+
+struct ShortWalker {
+  Recipe recipe = Recipe::parse("{env: {max_episode_steps: 100, success_steps: 100}}", "test");
+  std::function<std::unique_ptr<Env>()> make = task_factory("walker_forward", recipe.root().sub("env"));
+  PpoConfig cfg;
+  ActorCriticSpec spec;
+  ShortWalker() {
+    cfg.num_envs = 8;
+    cfg.steps_per_env = 256;
+    cfg.minibatch_size = 512;
+    cfg.epochs = 10;
+    cfg.lr = 1e-3;
+    cfg.total_steps = 30 * 2048;
+    spec.obs_dim = 26;
+    spec.act_dim = 6;
+  }
+};
+
+double mean_return(const Policy& p, const ShortWalker& s) {
+  return summarize(evaluate_policy(p, s.make, 16, 123, 1).returns).mean;
+}
+
+}  // namespace
+
+TEST(PpoLearning, ImprovesReturnOnAShortWalkerHorizon) {
+  at::set_num_threads(1);
+  ShortWalker s;
+  VectorEnv envs(s.make, s.cfg.num_envs, 2);
+  PPO ppo(s.cfg, s.spec, envs, 7);
+  double before = mean_return(ppo.policy(), s);
+  while (ppo.global_step() < s.cfg.total_steps) ppo.iterate();
+  double after = mean_return(ppo.policy(), s);
+  // A random-init policy falls within ~40 steps (return ~60-100); after 60k steps it stays
+  // up and moves forward for most of the 100 steps.
+  EXPECT_GT(after, before + 50.0) << "before " << before << " after " << after;
+}
+
+TEST(PpoLearning, CheckpointResumeRestoresEverythingButInFlightEpisodes) {
+  at::set_num_threads(1);
+  ShortWalker s;
+  s.cfg.total_steps = 4 * 2048;
+  auto dir = std::filesystem::temp_directory_path() / ("segue_resume_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  std::string ckpt = (dir / "checkpoint.pt").string();
+
+  VectorEnv e1(s.make, s.cfg.num_envs, 1);
+  PPO a(s.cfg, s.spec, e1, 5);
+  a.iterate();
+  a.iterate();
+  a.save(ckpt);
+  VectorEnv e2(s.make, s.cfg.num_envs, 1);
+  PPO b(s.cfg, s.spec, e2, 5);
+  b.load(ckpt);
+  EXPECT_EQ(b.iteration(), 2);
+  EXPECT_EQ(b.global_step(), 2 * 2048);
+  // Same weights, normaliser and optimiser moments: identical deterministic policy...
+  std::vector<float> obs(26 * 3, 0.3f), pa(18), pb(18);
+  a.policy().act(obs.data(), 3, pa.data());
+  b.policy().act(obs.data(), 3, pb.data());
+  EXPECT_EQ(pa, pb);
+  auto pa_params = a.net()->parameters(), pb_params = b.net()->parameters();
+  for (size_t i = 0; i < pa_params.size(); ++i) EXPECT_TRUE(torch::equal(pa_params[i], pb_params[i]));
+  // ...and training goes on from there.
+  b.iterate();
+  EXPECT_EQ(b.global_step(), 3 * 2048);
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace segue

@@ -1,0 +1,119 @@
+// Recipes: strict keys, types, overrides, and the CLI's one-line errors.
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "core/recipe.h"
+
+namespace segue {
+
+TEST(Recipe, ReadsValuesDefaultsAndOverrides) {
+  Recipe r = Recipe::parse("ppo: {lr: 0.001, total_steps: 2e6}\nseed: 3\n", "r.yaml",
+                           {"ppo.epochs=4", "env.push_prob=0"});
+  Section ppo = r.root().sub("ppo");
+  EXPECT_DOUBLE_EQ(ppo.get("lr", 1.0), 0.001);
+  EXPECT_EQ(ppo.get<int64_t>("total_steps", 0), 2000000);
+  EXPECT_EQ(ppo.get("epochs", 10), 4);
+  EXPECT_EQ(ppo.get("minibatch_size", 64), 64);  // default
+  EXPECT_EQ(r.root().get("seed", 0), 3);
+  EXPECT_DOUBLE_EQ(r.root().sub("env").get("push_prob", 0.2), 0.0);
+  EXPECT_NO_THROW(r.reject_unknown());
+  // The resolved recipe records defaults too.
+  EXPECT_NE(r.resolved_yaml().find("minibatch_size: 64"), std::string::npos);
+}
+
+TEST(Recipe, UnknownKeyIsNamedWithASuggestion) {
+  Recipe r = Recipe::parse("ppo: {lrr: 0.1}\n", "r.yaml");
+  r.root().sub("ppo").get("lr", 1.0);
+  try {
+    r.reject_unknown();
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "r.yaml: unknown key 'ppo.lrr'; did you mean 'ppo.lr'?");
+  }
+}
+
+TEST(Recipe, WrongTypeAndMalformedYaml) {
+  Recipe r = Recipe::parse("ppo: {epochs: many, lr: [1, 2]}\n", "r.yaml");
+  try {
+    r.root().sub("ppo").get("epochs", 10);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "r.yaml: key 'ppo.epochs' expects an integer, got 'many'");
+  }
+  EXPECT_THROW(r.root().sub("ppo").get("lr", 1.0), Error);
+  EXPECT_THROW(r.root().sub("ppo").get("epochs", 1.5) /* 'many' is not a number either */, Error);
+  try {
+    Recipe::parse("ppo: {lr: 1\n  bad", "m.yaml");
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("m.yaml: malformed YAML at line", 0), 0u) << e.what();
+  }
+  EXPECT_THROW(Recipe::load("/nonexistent/recipe.yaml"), Error);
+  EXPECT_THROW(Recipe::parse("{}", "r", {"no_equals_sign"}), Error);
+}
+
+// The segue binary: each bad input gives exit code 1 and one "error: ..." line.
+struct CliRun {
+  int code;
+  std::string output;
+};
+CliRun run(const std::string& args) {
+  std::string cmd = std::string(SEGUE_BINARY) + " " + args + " 2>&1";
+  FILE* p = popen(cmd.c_str(), "r");
+  std::string out;
+  std::array<char, 512> buf;
+  while (fgets(buf.data(), buf.size(), p)) out += buf.data();
+  int status = pclose(p);
+  return {WEXITSTATUS(status), out};
+}
+
+class CliErrors : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("segue_cli_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string write(const std::string& name, const std::string& text) {
+    auto p = (dir_ / name).string();
+    std::ofstream(p) << text;
+    return p;
+  }
+  void expect_one_line_error(const CliRun& r, const std::string& needle) {
+    EXPECT_EQ(r.code, 1) << r.output;
+    EXPECT_EQ(r.output.rfind("error: ", 0), 0u) << r.output;
+    EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
+    EXPECT_NE(r.output.find(needle), std::string::npos) << r.output;
+  }
+  std::filesystem::path dir_;
+};
+
+TEST_F(CliErrors, BadRecipes) {
+  auto bad_yaml = write("bad.yaml", "task: walker_forward\nppo: {lr: 1\n");
+  expect_one_line_error(run("train " + bad_yaml), "bad.yaml: malformed YAML");
+  auto unknown = write("unknown.yaml", "task: walker_forward\nppo: {learning_rate: 0.1}\n");
+  expect_one_line_error(run("train " + unknown), "unknown key 'ppo.learning_rate'");
+  auto wrong = write("wrong.yaml", "task: walker_forward\nppo: {epochs: ten}\n");
+  expect_one_line_error(run("train " + wrong), "key 'ppo.epochs' expects an integer, got 'ten'");
+  auto task = write("task.yaml", "task: walker_sideways\n");
+  expect_one_line_error(run("train " + task), "key 'task': unknown task 'walker_sideways'");
+  expect_one_line_error(run("train " + (dir_ / "missing.yaml").string()), "missing.yaml: cannot read recipe");
+  auto ok = write("ok.yaml", "task: walker_forward\n");
+  expect_one_line_error(run("train " + ok + " --set ppo.lrr=1"), "unknown key 'ppo.lrr' (from --set)");
+}
+
+TEST_F(CliErrors, BadPoliciesAndFlags) {
+  auto junk = write("junk.pt", "garbage");
+  expect_one_line_error(run("eval " + junk + " --task walker_forward --episodes 1"), "junk.pt");
+  expect_one_line_error(run("eval " + (dir_ / "nope.pt").string() + " --task walker_forward"),
+                        "nope.pt: no such policy file");
+  expect_one_line_error(run("eval x.pt --task walker_forward --episodes two"), "--episodes expects an integer");
+  expect_one_line_error(run("eval x.pt --task walker_forward --bogus"), "unknown flag --bogus");
+  EXPECT_EQ(run("train --help").code, 0);
+}
+
+}  // namespace segue

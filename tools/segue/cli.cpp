@@ -1,0 +1,109 @@
+#include "tools/segue/cli.h"
+
+#include <torch/torch.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "core/thread_pool.h"
+
+namespace segue::cli {
+
+Args::Args(const Command& cmd, int argc, char** argv) : cmd_(cmd) {
+  for (int i = 0; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a == "-h" || a == "--help") {
+      help_ = true;
+      return;
+    }
+    if (a.rfind("--", 0) == 0) {
+      std::string name = a.substr(2), value;
+      bool inline_value = false;
+      if (auto eq = name.find('='); eq != std::string::npos) {
+        value = name.substr(eq + 1);
+        name = name.substr(0, eq);
+        inline_value = true;
+      }
+      const Flag* flag = nullptr;
+      for (const auto& f : cmd.flags)
+        if (f.name == name) flag = &f;
+      if (!flag) throw Error("segue " + cmd.name + ": unknown flag --" + name + " (see segue " + cmd.name + " --help)");
+      if (!flag->value.empty() && !inline_value) {
+        if (i + 1 >= argc) throw Error("segue " + cmd.name + ": --" + name + " needs a value " + flag->value);
+        value = argv[++i];
+      }
+      if (!flag->repeatable && values_.count(name))
+        throw Error("segue " + cmd.name + ": --" + name + " given twice");
+      values_.emplace(name, value);
+    } else {
+      positionals_.push_back(a);
+    }
+  }
+  if (positionals_.size() != cmd.positionals.size())
+    throw Error("segue " + cmd.name + ": expected " + cmd.usage + " (see segue " + cmd.name + " --help)");
+}
+
+std::string Args::get(const std::string& flag, const std::string& fallback) const {
+  auto it = values_.find(flag);
+  return it == values_.end() ? fallback : it->second;
+}
+
+int Args::get_int(const std::string& flag, int fallback) const {
+  auto it = values_.find(flag);
+  if (it == values_.end()) return fallback;
+  try {
+    size_t used;
+    int v = std::stoi(it->second, &used);
+    if (used == it->second.size()) return v;
+  } catch (const std::exception&) {
+  }
+  throw Error("segue " + cmd_.name + ": --" + flag + " expects an integer, got '" + it->second + "'");
+}
+
+std::vector<std::string> Args::all(const std::string& flag) const {
+  std::vector<std::string> out;
+  auto range = values_.equal_range(flag);
+  for (auto it = range.first; it != range.second; ++it) out.push_back(it->second);
+  return out;
+}
+
+std::string help_text(const Command& cmd) {
+  std::ostringstream o;
+  o << "usage: segue " << cmd.name << " " << cmd.usage << "\n\n" << cmd.summary << "\n";
+  if (!cmd.flags.empty()) o << "\nflags:\n";
+  for (const auto& f : cmd.flags) {
+    std::string left = "--" + f.name + (f.value.empty() ? "" : " " + f.value);
+    o << "  " << left << std::string(left.size() < 22 ? 22 - left.size() : 1, ' ') << f.help << "\n";
+  }
+  o << "  --help                show this help\n";
+  return o.str();
+}
+
+void set_torch_threads(int threads) {
+  at::set_num_threads(resolve_threads(threads));
+  static bool interop_set = false;  // may only be set once per process
+  if (!interop_set) {
+    at::set_num_interop_threads(1);
+    interop_set = true;
+  }
+}
+
+}  // namespace segue::cli
+
+namespace segue::cli {
+
+std::string json_object(const std::vector<std::pair<std::string, double>>& fields) {
+  std::ostringstream o;
+  o.precision(10);
+  o << "{";
+  for (size_t i = 0; i < fields.size(); ++i) {
+    o << (i ? ", " : "") << "\"" << fields[i].first << "\": ";
+    double v = fields[i].second;
+    if (!std::isfinite(v)) o << "null";
+    else o << v;
+  }
+  o << "}";
+  return o.str();
+}
+
+}  // namespace segue::cli

@@ -1,0 +1,59 @@
+#pragma once
+// Command-line plumbing shared by the segue commands: flag parsing with per-command
+// help, and the one-line error convention.
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+
+namespace segue::cli {
+
+struct Flag {
+  std::string name;   // without dashes
+  std::string value;  // placeholder shown in help; empty for a boolean switch
+  std::string help;
+  bool repeatable = false;
+};
+
+struct Command {
+  std::string name, usage, summary;
+  std::vector<std::string> positionals;  // names, all required
+  std::vector<Flag> flags;
+};
+
+class Args {
+ public:
+  // Throws segue::Error on an unknown flag or a missing value/positional.
+  Args(const Command& cmd, int argc, char** argv);
+  bool help() const { return help_; }
+  const std::string& positional(size_t i) const { return positionals_.at(i); }
+  bool has(const std::string& flag) const { return values_.count(flag) > 0; }
+  std::string get(const std::string& flag, const std::string& fallback) const;
+  int get_int(const std::string& flag, int fallback) const;
+  std::vector<std::string> all(const std::string& flag) const;
+
+ private:
+  const Command& cmd_;
+  bool help_ = false;
+  std::vector<std::string> positionals_;
+  std::multimap<std::string, std::string> values_;
+};
+
+std::string help_text(const Command& cmd);
+
+// Commands: each returns the process exit code.
+int train_main(int argc, char** argv);
+int eval_main(int argc, char** argv);
+int export_main(int argc, char** argv);
+int bench_main(int argc, char** argv);
+
+// Sets LibTorch's intra-op threads; 0 means every core.
+void set_torch_threads(int threads);
+
+}  // namespace segue::cli
+
+namespace segue::cli {
+// {"k": v, ...} with numbers printed to full precision (integers without decimals).
+std::string json_object(const std::vector<std::pair<std::string, double>>& fields);
+}  // namespace segue::cli
