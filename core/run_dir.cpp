@@ -67,7 +67,7 @@ RunDir::RunDir(const std::string& dir, const std::string& resolved) : dir_(dir) 
   if (fs::exists(recipe)) {
     if (read_file(recipe) != resolved)
       throw Error(recipe + ": this run directory was started with a different recipe; "
-                  "choose another run.dir or remove the directory");
+                  "choose another run_dir or remove the directory");
   } else {
     write_file_atomic(recipe, resolved);
   }

@@ -5,8 +5,7 @@
 
 namespace segue {
 
-WalkerConfig WalkerConfig::read(const Section& s) {
-  WalkerConfig c;
+WalkerConfig WalkerConfig::read(const Section& s, WalkerConfig c) {
   c.max_episode_steps = s.get("max_episode_steps", c.max_episode_steps);
   c.success_steps = s.get("success_steps", c.success_steps);
   c.init_noise = s.get("init_noise", c.init_noise);
@@ -25,8 +24,8 @@ WalkerConfig WalkerConfig::read(const Section& s) {
   return c;
 }
 
-WalkerEnv::WalkerEnv(const std::string& name, const WalkerConfig& config)
-    : MujocoEnv("walker/walker.xml", 4), cfg_(config) {
+WalkerEnv::WalkerEnv(const std::string& name, const WalkerConfig& config, const std::string& model_file)
+    : MujocoEnv(model_file, 4), cfg_(config) {
   spec_.name = name;
   spec_.obs_dim = kBaseObsDim;
   spec_.max_episode_steps = cfg_.max_episode_steps;
@@ -48,6 +47,16 @@ double WalkerEnv::delta_h() const {
 
 double WalkerEnv::min_x() const {
   return std::min({data_->xpos[3 * torso_], data_->xpos[3 * foot_], data_->xpos[3 * foot_left_]});
+}
+
+double WalkerEnv::trailing_foot_x() const {
+  return std::min(data_->xpos[3 * foot_], data_->xpos[3 * foot_left_]);
+}
+
+double WalkerEnv::walk_reward(double v, const float* action, double speed_weight,
+                              double height_weight) const {
+  return speed_weight * speed_term(v) - height_weight * std::abs(cfg_.height_target - delta_h()) +
+         posture_terms(action);
 }
 
 void WalkerEnv::reset_task() {
@@ -94,7 +103,7 @@ WalkerWalk::WalkerWalk(const std::string& name, const WalkerConfig& config, doub
 StepResult WalkerWalk::evaluate(const float* action) {
   StepResult r;
   double v = x_velocity();
-  r.reward = speed_term(direction_ * v) - std::abs(cfg_.height_target - delta_h()) + posture_terms(action);
+  r.reward = walk_reward(direction_ * v, action, 1.0, 1.0);
   r.terminated = fallen();
   r.info.success = !r.terminated && t_ >= cfg_.success_steps;
   r.info.success_count = r.info.success ? 1 : 0;

@@ -3,6 +3,8 @@
 // 26-number observation, the reference reward terms, the randomised start and the
 // random pushes. Reference values come from ../shared/spec/environments.md and can be
 // changed from a recipe's `env:` section.
+#include <cmath>
+
 #include "core/mujoco_env.h"
 #include "core/recipe.h"
 
@@ -24,13 +26,16 @@ struct WalkerConfig {
   double foot_cost = 0.01;      // - foot_cost (|foot joint velocities| summed)
   double ctrl_cost = 1e-3;      // - ctrl_cost |a|^2
 
-  static WalkerConfig read(const Section& env);
+  // Reads `env`, starting from `defaults` (each task has its own reference values).
+  static WalkerConfig read(const Section& env, WalkerConfig defaults);
+  static WalkerConfig read(const Section& env) { return read(env, WalkerConfig()); }
 };
 
 class WalkerEnv : public MujocoEnv {
  public:
   static constexpr int kBaseObsDim = 26;
-  WalkerEnv(const std::string& name, const WalkerConfig& config);
+  WalkerEnv(const std::string& name, const WalkerConfig& config,
+            const std::string& model_file = "walker/walker.xml");
 
   double torso_x() const { return data_->qpos[qx_]; }
   double torso_z() const { return data_->qpos[qz_]; }
@@ -39,6 +44,10 @@ class WalkerEnv : public MujocoEnv {
   double delta_h() const;
   // Smallest x of torso and feet: obstacle distances are measured from it.
   double min_x() const;
+  // The trailing foot's x: the reference rewards crossing points "with the lowest foot".
+  double trailing_foot_x() const;
+  // Torso vertical velocity.
+  double z_velocity() const { return data_->qvel[qz_]; }
   bool fallen() const { return torso_z() < cfg_.fall_height; }
 
  protected:
@@ -53,6 +62,10 @@ class WalkerEnv : public MujocoEnv {
   double x_velocity() const { return (torso_x() - x_before_) / control_dt(); }
 
   WalkerConfig cfg_;
+  // Forward-velocity, height and posture terms shared by walk-like rewards:
+  //   speed_weight v' + upright + alive - height_weight |h* - dh| - foot - ctrl.
+  double walk_reward(double v, const float* action, double speed_weight, double height_weight) const;
+
   double x_before_ = 0.0;
   int qx_, qz_, qpitch_;
   int foot_, foot_left_, torso_;

@@ -47,6 +47,7 @@ int train_main(int argc, char** argv);
 int eval_main(int argc, char** argv);
 int export_main(int argc, char** argv);
 int bench_main(int argc, char** argv);
+int render_main(int argc, char** argv);
 
 // Sets LibTorch's intra-op threads; 0 means every core.
 void set_torch_threads(int threads);

@@ -17,6 +17,7 @@ const char* kUsage =
     "  train RECIPE       train a skill with PPO from a YAML recipe (resumes an interrupted run)\n"
     "  eval POLICY        evaluate a checkpoint or exported policy on a task\n"
     "  export CKPT OUT    write a checkpoint's policy as TorchScript\n"
+    "  render POLICY      render one episode of a policy to a video, headless\n"
     "  bench              measure physics, rollout and PPO throughput\n\n"
     "Run 'segue COMMAND --help' for a command's flags.\n";
 
@@ -33,6 +34,7 @@ int main(int argc, char** argv) {
     if (cmd == "train") return segue::cli::train_main(argc - 2, argv + 2);
     if (cmd == "eval") return segue::cli::eval_main(argc - 2, argv + 2);
     if (cmd == "export") return segue::cli::export_main(argc - 2, argv + 2);
+    if (cmd == "render") return segue::cli::render_main(argc - 2, argv + 2);
     if (cmd == "bench") return segue::cli::bench_main(argc - 2, argv + 2);
     std::fprintf(stderr, "segue: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
     return 2;

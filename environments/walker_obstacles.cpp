@@ -1,0 +1,207 @@
+#include "environments/walker_obstacles.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace segue {
+
+ObstacleConfig ObstacleConfig::read(const Section& s, ObstacleConfig c) {
+  c.detect_distance = s.get("detect_distance", c.detect_distance);
+  c.curb_far_start = s.get("curb_far_start", c.curb_far_start);
+  c.curb_far_end = s.get("curb_far_end", c.curb_far_end);
+  c.ceiling_far_start = s.get("ceiling_far_start", c.ceiling_far_start);
+  c.ceiling_far_end = s.get("ceiling_far_end", c.ceiling_far_end);
+  c.pass_margin = s.get("pass_margin", c.pass_margin);
+  c.contact_penalty = s.get("contact_penalty", c.contact_penalty);
+  c.ceiling_length = s.get("ceiling_length", c.ceiling_length);
+  return c;
+}
+
+WalkerObstacleEnv::WalkerObstacleEnv(const std::string& name, const WalkerConfig& walker,
+                                     const ObstacleConfig& o, bool observe_obstacle)
+    : WalkerEnv(name, walker, "walker/walker_obstacles.xml"), ocfg_(o), observe_obstacle_(observe_obstacle) {
+  if (observe_obstacle_) spec_.obs_dim = kBaseObsDim + 2;
+  geom_kind_.assign(model_->ngeom, 0);
+  for (int i = 0;; ++i) {
+    int curb = mj_name2id(model_, mjOBJ_GEOM, ("curb" + std::to_string(i)).c_str());
+    int ceiling = mj_name2id(model_, mjOBJ_GEOM, ("ceiling" + std::to_string(i)).c_str());
+    if (curb < 0 && ceiling < 0) break;
+    if (curb >= 0) curb_geoms_.push_back(curb), geom_kind_[curb] = int(ObstacleKind::Curb);
+    if (ceiling >= 0) ceiling_geoms_.push_back(ceiling), geom_kind_[ceiling] = int(ObstacleKind::Ceiling);
+  }
+  parked_pos_.assign(model_->geom_pos, model_->geom_pos + 3 * model_->ngeom);
+  parked_size_.assign(model_->geom_size, model_->geom_size + 3 * model_->ngeom);
+}
+
+void WalkerObstacleEnv::set_obstacles(const std::vector<Obstacle>& layout) {
+  obstacles_ = layout;
+  passed_ = 0;
+  for (int g : curb_geoms_)
+    for (int k = 0; k < 3; ++k) model_->geom_pos[3 * g + k] = parked_pos_[3 * g + k];
+  for (int g : ceiling_geoms_)
+    for (int k = 0; k < 3; ++k) {
+      model_->geom_pos[3 * g + k] = parked_pos_[3 * g + k];
+      model_->geom_size[3 * g + k] = parked_size_[3 * g + k];
+    }
+  size_t curbs = 0, ceilings = 0;
+  for (const auto& o : layout) {
+    bool curb = o.kind == ObstacleKind::Curb;
+    auto& pool = curb ? curb_geoms_ : ceiling_geoms_;
+    size_t& used = curb ? curbs : ceilings;
+    if (used >= pool.size()) throw Error(spec_.name + ": the obstacle model has too few " + (curb ? "curbs" : "ceilings"));
+    int g = pool[used++];
+    model_->geom_pos[3 * g] = 0.5 * (o.start + o.end);
+    if (!curb) model_->geom_size[3 * g] = 0.5 * (o.end - o.start);
+    // The broad phase uses the bounding sphere: keep it in step with the size.
+    const double* s = &model_->geom_size[3 * g];
+    model_->geom_rbound[g] = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+  }
+}
+
+int WalkerObstacleEnv::next_obstacle() const {
+  double x = min_x();
+  for (size_t i = 0; i < obstacles_.size(); ++i)
+    if (obstacles_[i].end > x) return static_cast<int>(i);
+  return -1;
+}
+
+void WalkerObstacleEnv::obstacle_observation(double& start, double& end) const {
+  int i = next_obstacle();
+  double x = min_x();
+  bool ceiling = i >= 0 && obstacles_[i].kind == ObstacleKind::Ceiling;
+  if (i >= 0 && obstacles_[i].start - x <= ocfg_.detect_distance) {
+    start = obstacles_[i].start - x;
+    end = obstacles_[i].end - x;
+  } else {
+    start = ceiling ? ocfg_.ceiling_far_start : ocfg_.curb_far_start;
+    end = ceiling ? ocfg_.ceiling_far_end : ocfg_.curb_far_end;
+  }
+}
+
+bool WalkerObstacleEnv::touching(int kind) const {
+  for (int c = 0; c < data_->ncon; ++c) {
+    int k1 = geom_kind_[data_->contact[c].geom1], k2 = geom_kind_[data_->contact[c].geom2];
+    if ((k1 && (kind == 0 || k1 == kind)) || (k2 && (kind == 0 || k2 == kind))) return true;
+  }
+  return false;
+}
+
+int WalkerObstacleEnv::update_passed() {
+  int before = passed_;
+  double x = min_x();
+  while (passed_ < int(obstacles_.size()) && x > obstacles_[passed_].end + ocfg_.pass_margin) ++passed_;
+  return passed_ - before;
+}
+
+void WalkerObstacleEnv::observe(float* obs) const {
+  WalkerEnv::observe(obs);
+  if (!observe_obstacle_) return;
+  double s, e;
+  obstacle_observation(s, e);
+  obs[kBaseObsDim] = static_cast<float>(s);
+  obs[kBaseObsDim + 1] = static_cast<float>(e);
+}
+
+void WalkerObstacleEnv::save_task_state(std::vector<double>& out) const {
+  out.push_back(double(obstacles_.size()));
+  for (const auto& o : obstacles_) {
+    out.push_back(double(int(o.kind)));
+    out.push_back(o.start);
+    out.push_back(o.end);
+  }
+  out.push_back(passed_);
+  size_t before = out.size();
+  save_extra(out);
+  out.push_back(double(out.size() - before));
+}
+
+void WalkerObstacleEnv::restore_task_state(const double* in, size_t n) {
+  if (n < 2) throw Error(spec_.name + ": saved state has no obstacle layout");
+  size_t count = size_t(in[0]);
+  std::vector<Obstacle> layout;
+  for (size_t i = 0; i < count; ++i)
+    layout.push_back({ObstacleKind(int(in[1 + 3 * i])), in[2 + 3 * i], in[3 + 3 * i]});
+  set_obstacles(layout);
+  passed_ = int(in[1 + 3 * count]);
+  size_t extra = size_t(in[n - 1]);
+  restore_extra(in + 2 + 3 * count, extra);
+}
+
+// ---- jump ------------------------------------------------------------------------------
+
+WalkerJump::WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c)
+    : WalkerObstacleEnv(name, w, o, true), jcfg_(c) {}
+
+void WalkerJump::reset_task() {
+  double start = jcfg_.curb_x + rng_.symmetric(jcfg_.curb_noise);
+  set_obstacles({{ObstacleKind::Curb, start, start + ocfg_.curb_width}});
+  crossed_ = 0;
+  WalkerEnv::reset_task();
+}
+
+StepResult WalkerJump::evaluate(const float* action) {
+  StepResult r;
+  const Obstacle& curb = obstacles_[0];
+  double v = x_velocity();
+  r.reward = walk_reward(v, action, 2.0, 2.0);
+  // Bonuses for the trailing foot crossing the curb's start, centre and end.
+  const double marks[3] = {curb.start, 0.5 * (curb.start + curb.end), curb.end};
+  while (crossed_ < 3 && trailing_foot_x() > marks[crossed_]) {
+    r.reward += jcfg_.cross_bonus;
+    ++crossed_;
+  }
+  double x = min_x();
+  if (x > curb.start - 1.0 && x < curb.end) r.reward += jcfg_.upward_weight * std::max(z_velocity(), 0.0);
+  bool contact = touching();
+  if (contact) r.reward -= ocfg_.contact_penalty;
+  update_passed();
+  r.info.success = passed_ > 0;
+  r.info.success_count = passed_;
+  r.info.metrics[0] = v;
+  r.terminated = fallen() || contact || x > jcfg_.end_x;
+  return r;
+}
+
+void WalkerJump::save_extra(std::vector<double>& out) const { out.push_back(crossed_); }
+void WalkerJump::restore_extra(const double* in, size_t n) { crossed_ = n ? int(in[0]) : 0; }
+
+// ---- crawl -----------------------------------------------------------------------------
+
+WalkerCrawl::WalkerCrawl(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c)
+    : WalkerObstacleEnv(name, w, o, false), ccfg_(c) {}
+
+void WalkerCrawl::reset_task() {
+  set_obstacles({{ObstacleKind::Ceiling, ccfg_.ceiling_start, ccfg_.ceiling_end}});
+  WalkerEnv::reset_task();
+}
+
+StepResult WalkerCrawl::evaluate(const float* action) {
+  StepResult r;
+  double v = x_velocity();
+  r.reward = walk_reward(v, action, 2.0, 0.0);  // no height term: crawling is low
+  bool contact = touching();
+  if (contact) r.reward -= ocfg_.contact_penalty;
+  r.terminated = fallen() || contact;
+  r.info.success = !r.terminated && t_ >= cfg_.success_steps;
+  r.info.success_count = r.info.success ? 1 : 0;
+  r.info.metrics[0] = v;
+  if (r.info.success) r.truncated = true;
+  return r;
+}
+
+// ---- balance ---------------------------------------------------------------------------
+
+StepResult WalkerBalance::evaluate(const float* action) {
+  StepResult r;
+  double v = x_velocity();
+  r.reward = -std::abs(v) - 0.5 * std::abs(cfg_.height_target - delta_h()) + posture_terms(action);
+  r.terminated = fallen();
+  r.info.success = !r.terminated && t_ >= cfg_.success_steps;
+  r.info.success_count = r.info.success ? 1 : 0;
+  r.info.metrics[0] = v;
+  if (r.info.success) r.truncated = true;
+  return r;
+}
+
+}  // namespace segue

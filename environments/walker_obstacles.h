@@ -1,0 +1,118 @@
+#pragma once
+// The walker among curbs and ceilings (assets/walker/walker_obstacles.xml). The model
+// carries five of each, parked behind the start; a task lays out the ones it uses at
+// reset. Obstacle observations follow the reference: (start - x, end - x) of the next
+// obstacle, x the smallest x of torso and feet, or fixed "far" values when the next
+// obstacle is beyond the detection distance.
+#include <vector>
+
+#include "environments/walker.h"
+
+namespace segue {
+
+enum class ObstacleKind { Curb = 1, Ceiling = 2 };
+
+struct Obstacle {
+  ObstacleKind kind;
+  double start, end;  // x extent
+};
+
+struct ObstacleConfig {
+  double detect_distance = 5.0;
+  double curb_far_start = 5.1, curb_far_end = 5.2;
+  double ceiling_far_start = 5.1, ceiling_far_end = 6.0;
+  double pass_margin = 1.5;      // an obstacle counts as passed when x > end + pass_margin
+  double contact_penalty = 10.0; // reward on touching an obstacle (the episode ends)
+  double curb_width = 0.2;       // curb thickness along x (the model's box is 0.2)
+  double ceiling_length = 3.0;   // ceiling length in composite courses
+
+  static ObstacleConfig read(const Section& env, ObstacleConfig defaults);
+  static ObstacleConfig read(const Section& env) { return read(env, ObstacleConfig()); }
+};
+
+class WalkerObstacleEnv : public WalkerEnv {
+ public:
+  // observe_obstacle: append the (start - x, end - x) pair to the 26 base numbers.
+  WalkerObstacleEnv(const std::string& name, const WalkerConfig& walker, const ObstacleConfig& obstacles,
+                    bool observe_obstacle);
+
+  const std::vector<Obstacle>& obstacles() const { return obstacles_; }
+  // The first obstacle whose end is still ahead of x, or -1.
+  int next_obstacle() const;
+  int passed() const { return passed_; }
+  // Any contact between the walker and an obstacle of that kind (0 = any kind).
+  bool touching(int kind = 0) const;
+  // The observation pair for the next obstacle (far values if none is near).
+  void obstacle_observation(double& start, double& end) const;
+
+ protected:
+  // Moves the model's obstacle geoms to this layout; unused ones are parked.
+  void set_obstacles(const std::vector<Obstacle>& layout);
+  // Counts obstacles newly passed this step (in course order); returns how many.
+  int update_passed();
+  void observe(float* obs) const override;
+  void save_task_state(std::vector<double>& out) const override;
+  void restore_task_state(const double* in, size_t n) override;
+  // Subclasses with state of their own extend these.
+  virtual void save_extra(std::vector<double>& out) const {}
+  virtual void restore_extra(const double* in, size_t n) {}
+
+  ObstacleConfig ocfg_;
+  std::vector<Obstacle> obstacles_;
+  int passed_ = 0;
+
+ private:
+  bool observe_obstacle_;
+  std::vector<int> curb_geoms_, ceiling_geoms_;
+  std::vector<double> parked_pos_, parked_size_;  // [ngeom * 3] as in the XML
+  std::vector<uint8_t> geom_kind_;                // ObstacleKind per geom, 0 for the rest
+};
+
+// Jump: one curb at curb_x + U(curb_noise); pass it without touching it.
+class WalkerJump : public WalkerObstacleEnv {
+ public:
+  struct Config {
+    double curb_x = 7.0, curb_noise = 1.5;
+    double cross_bonus = 10.0;  // once each for the trailing foot passing start, centre, end
+    double upward_weight = 1.0; // + upward_weight max(vz, 0) while over the curb
+    double end_x = 15.0;        // the episode ends past this x
+  };
+  WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
+
+ protected:
+  void reset_task() override;
+  StepResult evaluate(const float* action) override;
+  void save_extra(std::vector<double>& out) const override;
+  void restore_extra(const double* in, size_t n) override;
+
+ private:
+  Config jcfg_;
+  int crossed_ = 0;  // how many of start, centre, end the trailing foot has crossed
+};
+
+// Crawl: survive under a long ceiling (x from ceiling_start to ceiling_end).
+class WalkerCrawl : public WalkerObstacleEnv {
+ public:
+  struct Config {
+    double ceiling_start = 2.0, ceiling_end = 14.0;
+  };
+  WalkerCrawl(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
+
+ protected:
+  void reset_task() override;
+  StepResult evaluate(const float* action) override;
+
+ private:
+  Config ccfg_;
+};
+
+// Balance: stand still under strong pushes for success_steps steps.
+class WalkerBalance : public WalkerEnv {
+ public:
+  using WalkerEnv::WalkerEnv;
+
+ protected:
+  StepResult evaluate(const float* action) override;
+};
+
+}  // namespace segue

@@ -1,0 +1,181 @@
+// Walker sub-tasks: reset determinism, success rules triggered by scripted states,
+// obstacle observations against hand-computed values, snapshots that carry the layout.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "core/rng.h"
+#include "environments/registry.h"
+#include "environments/walker_obstacles.h"
+
+namespace segue {
+namespace {
+
+std::unique_ptr<Env> make(const std::string& task, const std::string& env = "{}") {
+  static std::vector<Recipe> keep;
+  keep.push_back(Recipe::parse("{env: " + env + "}", "test"));
+  return task_factory(task, keep.back().root().sub("env"))();
+}
+
+// Moves the whole walker by dx along x (rootx) and recomputes positions.
+void shift_x(Env& env, double x, std::vector<float>& obs) {
+  auto& m = dynamic_cast<MujocoEnv&>(env);
+  m.mutable_data()->qpos[0] = x;
+  m.forward(obs.data());
+}
+
+const float kZero[6] = {0, 0, 0, 0, 0, 0};
+
+}  // namespace
+
+TEST(WalkerSubtasks, ShapesFollowTheSpec) {
+  EXPECT_EQ(make("walker_backward")->spec().obs_dim, 26);
+  EXPECT_EQ(make("walker_balance")->spec().obs_dim, 26);
+  EXPECT_EQ(make("walker_crawl")->spec().obs_dim, 26);
+  EXPECT_EQ(make("walker_jump")->spec().obs_dim, 28);
+  for (auto t : {"walker_backward", "walker_balance", "walker_crawl", "walker_jump"})
+    EXPECT_EQ(make(t)->spec().act_dim, 6) << t;
+}
+
+TEST(WalkerSubtasks, ResetIsDeterministicPerSeed) {
+  for (auto t : {"walker_backward", "walker_balance", "walker_crawl", "walker_jump"}) {
+    auto a = make(t), b = make(t);
+    int d = a->spec().obs_dim;
+    std::vector<float> oa(d), ob(d);
+    a->reset(9, oa.data());
+    b->reset(9, ob.data());
+    EXPECT_EQ(oa, ob) << t;
+    b->reset(10, ob.data());
+    EXPECT_NE(oa, ob) << t;
+  }
+}
+
+TEST(WalkerJump, ObstacleObservationByHand) {
+  auto env = make("walker_jump", "{curb_noise: 0, init_noise: 0, init_random_steps: 0, push_prob: 0}");
+  auto& jump = dynamic_cast<WalkerObstacleEnv&>(*env);
+  std::vector<float> obs(28);
+  env->reset(0, obs.data());
+  // Curb from 7.0 to 7.2. At the reference pose the smallest x of torso and feet is the
+  // ankle bodies' and torso's x = 0: the curb is 7 m away, beyond the 5 m detection
+  // distance, so the pair takes the curb's "far" values.
+  EXPECT_FLOAT_EQ(obs[26], 5.1f);
+  EXPECT_FLOAT_EQ(obs[27], 5.2f);
+  shift_x(*env, 3.0, obs);  // now 4 m before the curb: within detection
+  EXPECT_NEAR(jump.min_x(), 3.0, 1e-9);
+  EXPECT_NEAR(obs[26], 4.0, 1e-6);
+  EXPECT_NEAR(obs[27], 4.2, 1e-6);
+  shift_x(*env, 7.1, obs);  // on top of the curb: start behind, end ahead
+  EXPECT_NEAR(obs[26], -0.1, 1e-6);
+  EXPECT_NEAR(obs[27], 0.1, 1e-6);
+  shift_x(*env, 7.5, obs);  // past it: no obstacle ahead
+  EXPECT_FLOAT_EQ(obs[26], 5.1f);
+}
+
+TEST(WalkerJump, PassingTheCurbSucceedsAndTouchingItFails) {
+  auto env = make("walker_jump", "{curb_noise: 0, push_prob: 0}");
+  std::vector<float> obs(28);
+  env->reset(1, obs.data());
+  // Lift the walker and put it 1.5 m past the curb's end (7.2): success on the next step.
+  auto& m = dynamic_cast<MujocoEnv&>(*env);
+  m.mutable_data()->qpos[0] = 7.2 + 1.5 + 0.05;
+  m.forward(obs.data());
+  StepResult r = env->step(kZero, obs.data());
+  EXPECT_TRUE(r.info.success);
+  EXPECT_EQ(r.info.success_count, 1);
+  // The three crossing bonuses (start, centre, end) were paid at once.
+  EXPECT_GT(r.reward, 25.0);
+  EXPECT_FALSE(r.terminated);
+
+  // Standing inside the curb: contact ends the episode with the penalty.
+  env->reset(2, obs.data());
+  m.mutable_data()->qpos[0] = 6.9;  // feet (0.2 m ahead of the ankle) overlap the curb's start
+  m.forward(obs.data());
+  r = env->step(kZero, obs.data());
+  EXPECT_TRUE(r.terminated);
+  EXPECT_FALSE(r.info.success);
+  EXPECT_LT(r.reward, -5.0);
+}
+
+TEST(WalkerJump, EpisodeEndsPastX15) {
+  auto env = make("walker_jump", "{curb_noise: 0, push_prob: 0}");
+  std::vector<float> obs(28);
+  env->reset(1, obs.data());
+  shift_x(*env, 15.5, obs);
+  StepResult r = env->step(kZero, obs.data());
+  EXPECT_TRUE(r.terminated);
+  EXPECT_TRUE(r.info.success);  // the curb was passed on the way
+}
+
+TEST(WalkerJump, SnapshotCarriesTheCurbPosition) {
+  auto a = make("walker_jump", "{push_prob: 0}"), b = make("walker_jump", "{push_prob: 0}");
+  std::vector<float> oa(28), ob(28), act(6);
+  a->reset(3, oa.data());
+  b->reset(4, ob.data());  // a different curb position
+  shift_x(*a, 4.0, oa);    // within detection, so the curb shows in the observation
+  std::vector<double> s;
+  a->save_state(s);
+  b->restore_state(s, ob.data());
+  EXPECT_EQ(oa, ob);
+  for (int t = 0; t < 100; ++t) {
+    Rng r(t);
+    for (auto& x : act) x = float(r.symmetric(1));
+    StepResult ra = a->step(act.data(), oa.data()), rb = b->step(act.data(), ob.data());
+    ASSERT_EQ(oa, ob) << t;
+    ASSERT_EQ(ra.reward, rb.reward) << t;
+    if (ra.done()) break;
+  }
+}
+
+TEST(WalkerCrawl, StandingUnderTheCeilingTouchesIt) {
+  auto env = make("walker_crawl", "{push_prob: 0}");
+  std::vector<float> obs(26);
+  env->reset(0, obs.data());
+  StepResult r = env->step(kZero, obs.data());
+  EXPECT_FALSE(r.terminated);  // the ceiling starts at x = 2
+  shift_x(*env, 5.0, obs);     // torso top at 1.45 m, ceiling underside at 0.9 m
+  r = env->step(kZero, obs.data());
+  EXPECT_TRUE(r.terminated);
+  EXPECT_LT(r.reward, -5.0);
+  // Crouched low (torso at 0.5 m) is not a fall for crawling (fall height 0.3).
+  env->reset(1, obs.data());
+  auto& m = dynamic_cast<MujocoEnv&>(*env);
+  m.mutable_data()->qpos[1] = 0.5;
+  m.forward(obs.data());
+  r = env->step(kZero, obs.data());
+  EXPECT_FALSE(r.terminated);
+}
+
+TEST(WalkerBalance, RewardAtRestAndSuccessAfterSurviving) {
+  auto env = make("walker_balance", "{init_noise: 0, init_random_steps: 0, push_prob: 0, success_steps: 20, max_episode_steps: 20}");
+  std::vector<float> obs(26);
+  env->reset(0, obs.data());
+  auto& w = dynamic_cast<WalkerEnv&>(*env);
+  StepResult r;
+  for (int t = 0; t < 20; ++t) {
+    w.mutable_data()->qpos[1] = 1.25;  // hold it up
+    double x0 = w.torso_x();
+    r = env->step(kZero, obs.data());
+    double v = (w.torso_x() - x0) / 0.008;
+    // -|v| - 0.5 |1.1 - dh| + 0.1 cos(pitch) + 1 (no foot or control cost at rest)
+    double want = -std::abs(v) - 0.5 * std::abs(1.1 - w.delta_h()) + 0.1 * std::cos(w.pitch()) + 1.0;
+    ASSERT_NEAR(r.reward, want, 1e-9) << t;
+  }
+  EXPECT_TRUE(r.info.success);
+  EXPECT_TRUE(r.truncated);
+}
+
+TEST(WalkerBackward, RewardsMovingInMinusX) {
+  auto env = make("walker_backward", "{init_noise: 0, init_random_steps: 0, push_prob: 0}");
+  std::vector<float> obs(26);
+  env->reset(0, obs.data());
+  auto& w = dynamic_cast<WalkerEnv&>(*env);
+  w.mutable_data()->qvel[0] = -2.0;  // sliding backwards at 2 m/s
+  StepResult back = env->step(kZero, obs.data());
+  env->reset(0, obs.data());
+  w.mutable_data()->qvel[0] = 2.0;
+  StepResult fwd = env->step(kZero, obs.data());
+  // v' = 3 - |(-v) - 3|: about 2 for v = -2 and about -2 for v = +2.
+  EXPECT_GT(back.reward - fwd.reward, 3.0);
+}
+
+}  // namespace segue
