@@ -15,6 +15,9 @@ struct EnvSpec {
   std::vector<float> act_low, act_high;   // action bounds in the environment's units
   int max_episode_steps = 1000;           // truncation horizon
   std::vector<std::string> metric_names;  // per-step task metrics reported in StepInfo
+  // Named quantities of the task state that a meta-controller reads to pick a skill and
+  // to detect transition intervals (e.g. "curb_ahead": metres to the next curb).
+  std::vector<std::string> feature_names;
 };
 
 constexpr int kMaxMetrics = 4;
@@ -42,6 +45,8 @@ class Env {
   // Starts an episode continuing the environment's own random stream.
   virtual void reset(float* obs) = 0;
   virtual StepResult step(const float* action, float* obs) = 0;
+  // Current values of spec().feature_names, in order.
+  virtual void features(double* out) const {}
 
   // Exact snapshot of everything the next step depends on (physics, task layout, step
   // counter), flattened to doubles so it can be stored in files. Restoring a snapshot

@@ -19,6 +19,10 @@ template <> const char* type_name<std::vector<std::string>>() { return "a list o
 
 namespace {
 
+bool is_index(const std::string& part) {
+  return !part.empty() && std::all_of(part.begin(), part.end(), [](char c) { return c >= '0' && c <= '9'; });
+}
+
 std::vector<std::string> split_key(const std::string& key) {
   std::vector<std::string> parts;
   std::stringstream ss(key);
@@ -44,16 +48,33 @@ size_t distance(const std::string& a, const std::string& b) {
 
 void set_path(YAML::Node root, const std::vector<std::string>& parts, const YAML::Node& value) {
   // yaml-cpp nodes are handles: walk down by reassigning a handle copy.
+  // Numeric parts index sequences ("transitions.0.from"), filled in order.
   std::vector<YAML::Node> chain{root};
   for (size_t i = 0; i + 1 < parts.size(); ++i) {
-    YAML::Node next = chain.back()[parts[i]];
-    if (!next.IsDefined() || !next.IsMap()) {
-      chain.back()[parts[i]] = YAML::Node(YAML::NodeType::Map);
-      next = chain.back()[parts[i]];
+    YAML::Node parent = chain.back();
+    bool next_is_index = is_index(parts[i + 1]);
+    auto fresh = [&] { return YAML::Node(next_is_index ? YAML::NodeType::Sequence : YAML::NodeType::Map); };
+    if (parent.IsSequence() && is_index(parts[i])) {
+      size_t k = std::stoul(parts[i]);
+      while (parent.size() <= k) parent.push_back(fresh());
+      chain.push_back(parent[k]);
+      continue;
+    }
+    YAML::Node next = parent[parts[i]];
+    if (!next.IsDefined() || !(next.IsMap() || next.IsSequence())) {
+      parent[parts[i]] = fresh();
+      next = parent[parts[i]];
     }
     chain.push_back(next);
   }
-  chain.back()[parts.back()] = value;
+  YAML::Node last = chain.back();
+  if (last.IsSequence() && is_index(parts.back())) {
+    size_t k = std::stoul(parts.back());
+    while (last.size() <= k) last.push_back(YAML::Node());
+    last[k] = value;
+  } else {
+    last[parts.back()] = value;
+  }
 }
 
 void collect_leaves(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& out) {
@@ -61,6 +82,8 @@ void collect_leaves(const YAML::Node& node, const std::string& prefix, std::vect
     for (const auto& kv : node)
       collect_leaves(kv.second, prefix.empty() ? kv.first.as<std::string>()
                                                : prefix + "." + kv.first.as<std::string>(), out);
+  } else if (node.IsSequence() && node.size() > 0 && node[0].IsMap()) {
+    for (size_t i = 0; i < node.size(); ++i) collect_leaves(node[i], prefix + "." + std::to_string(i), out);
   } else if (!prefix.empty()) {  // an empty document has no keys
     out.push_back(prefix);
   }
@@ -73,11 +96,19 @@ std::optional<YAML::Node> Section::lookup(const std::string& full_key) const {
   YAML::Node node;
   node.reset(s_->tree);
   for (const auto& part : split_key(full_key)) {
-    if (!node.IsMap()) return std::nullopt;
-    const YAML::Node& map = node;
-    YAML::Node child = map[part];
-    if (!child.IsDefined() || child.IsNull()) return std::nullopt;
-    node.reset(child);
+    const YAML::Node& parent = node;
+    if (parent.IsSequence() && is_index(part)) {
+      size_t i = std::stoul(part);
+      if (i >= parent.size()) return std::nullopt;
+      YAML::Node child = parent[i];
+      node.reset(child);
+    } else if (parent.IsMap()) {
+      YAML::Node child = parent[part];
+      if (!child.IsDefined() || child.IsNull()) return std::nullopt;
+      node.reset(child);
+    } else {
+      return std::nullopt;
+    }
   }
   return node;
 }
@@ -88,6 +119,33 @@ void Section::record(const std::string& full_key, const YAML::Node& value) const
 }
 
 bool Section::has(const std::string& key) const { return lookup(full(key)).has_value(); }
+
+bool Section::is_sequence(const std::string& key) const {
+  auto node = lookup(full(key));
+  return node && node->IsSequence();
+}
+
+std::vector<std::string> Section::keys() const {
+  std::vector<std::string> out;
+  auto node = prefix_.empty() ? std::optional<YAML::Node>(s_->tree) : lookup(prefix_);
+  if (node && node->IsMap())
+    for (const auto& kv : *node) out.push_back(kv.first.as<std::string>());
+  return out;
+}
+
+std::vector<Section> Section::items(const std::string& key) const {
+  std::string k = full(key);
+  s_->read.insert(k);
+  std::vector<Section> out;
+  auto node = lookup(k);
+  if (!node) return out;
+  if (!node->IsSequence()) throw Error(s_->file + ": key '" + k + "' should be a list");
+  for (size_t i = 0; i < node->size(); ++i) {
+    if (!(*node)[i].IsMap()) throw Error(s_->file + ": key '" + k + "." + std::to_string(i) + "' should be a mapping");
+    out.push_back(Section(s_, k + "." + std::to_string(i)));
+  }
+  return out;
+}
 
 Section Section::sub(const std::string& key) const {
   std::string k = full(key);
@@ -161,6 +219,8 @@ void Recipe::reject_unknown() const {
 
 std::string Recipe::resolved_yaml() const {
   YAML::Emitter e;
+  e.SetDoublePrecision(15);  // 0.2, not 0.20000000000000001
+  e.SetFloatPrecision(7);
   e << s_->resolved;
   return std::string(e.c_str()) + "\n";
 }

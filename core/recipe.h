@@ -26,7 +26,12 @@ class Section {
   template <class T>
   T require(const std::string& key) const;
   bool has(const std::string& key) const;
+  bool is_sequence(const std::string& key) const;
   Section sub(const std::string& key) const;
+  // The keys of this mapping, in document order.
+  std::vector<std::string> keys() const;
+  // The mappings of the sequence `key` (absent: none), each a Section "key.i".
+  std::vector<Section> items(const std::string& key) const;
   const std::string& path() const { return prefix_; }
   // "FILE: key 'a.b': msg" — the one-line error for a bad value found after reading.
   Error error(const std::string& key, const std::string& msg) const;
@@ -35,7 +40,9 @@ class Section {
   friend class Recipe;
   struct State;
   Section(std::shared_ptr<State> s, std::string prefix) : s_(std::move(s)), prefix_(std::move(prefix)) {}
-  std::string full(const std::string& key) const { return prefix_.empty() ? key : prefix_ + "." + key; }
+  std::string full(const std::string& key) const {
+    return prefix_.empty() ? key : key.empty() ? prefix_ : prefix_ + "." + key;
+  }
   std::optional<YAML::Node> lookup(const std::string& full_key) const;
   template <class T>
   T convert(const YAML::Node& node, const std::string& full_key) const;

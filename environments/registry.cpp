@@ -4,6 +4,7 @@
 #include <map>
 
 #include "environments/walker.h"
+#include "environments/walker_course.h"
 #include "environments/walker_obstacles.h"
 
 namespace segue {
@@ -50,6 +51,55 @@ Factory walker_crawl(const std::string& name, const Section& env) {
   return [=] { return std::make_unique<WalkerCrawl>(name, w, o, c); };
 }
 
+// Hurdle and Obstacle course differ only in their layout defaults.
+Builder walker_course(WalkerCourse::Config defaults, int max_steps) {
+  return [defaults, max_steps](const std::string& name, const Section& env) -> Factory {
+    WalkerConfig wd;
+    wd.max_episode_steps = max_steps;
+    WalkerConfig w = WalkerConfig::read(env, wd);
+    ObstacleConfig o = ObstacleConfig::read(env);
+    WalkerCourse::Config c = defaults;
+    c.positions = env.get("positions", c.positions);
+    c.position_noise = env.get("position_noise", c.position_noise);
+    c.kinds = env.get("kinds", c.kinds);
+    c.shuffle = env.get("shuffle", c.shuffle);
+    c.pass_bonus = env.get("pass_bonus", c.pass_bonus);
+    c.ceiling_zone = env.get("ceiling_zone", c.ceiling_zone);
+    c.ceiling_fall_height = env.get("ceiling_fall_height", c.ceiling_fall_height);
+    if (c.kinds.size() != c.positions.size())
+      throw env.error("kinds", "needs one entry per position (" + std::to_string(c.positions.size()) + ")");
+    for (const auto& k : c.kinds)
+      if (k != "curb" && k != "ceiling") throw env.error("kinds", "entries are 'curb' or 'ceiling', got '" + k + "'");
+    return [=] { return std::make_unique<WalkerCourse>(name, w, o, c); };
+  };
+}
+
+WalkerCourse::Config hurdle_layout() {
+  WalkerCourse::Config c;
+  c.positions = {8, 18, 28, 38, 48};
+  c.kinds.assign(5, "curb");
+  return c;
+}
+
+WalkerCourse::Config obstacle_course_layout() {
+  WalkerCourse::Config c;
+  c.positions = {8, 19, 30, 41, 52};
+  c.kinds = {"curb", "curb", "curb", "ceiling", "ceiling"};  // the reference code's mix
+  c.shuffle = true;
+  return c;
+}
+
+Factory walker_patrol(const std::string& name, const Section& env) {
+  WalkerConfig wd;
+  wd.max_episode_steps = 10000;
+  WalkerConfig w = WalkerConfig::read(env, wd);
+  WalkerPatrol::Config c;
+  c.stone_x = env.get("stone_x", c.stone_x);
+  c.max_turns = env.get("max_turns", c.max_turns);
+  c.turn_bonus = env.get("turn_bonus", c.turn_bonus);
+  return [=] { return std::make_unique<WalkerPatrol>(name, w, c); };
+}
+
 const std::map<std::string, Builder>& builders() {
   static const std::map<std::string, Builder> table = {
       {"walker_forward", walker_walk(+1.0)},
@@ -57,6 +107,9 @@ const std::map<std::string, Builder>& builders() {
       {"walker_balance", walker_balance},
       {"walker_jump", walker_jump},
       {"walker_crawl", walker_crawl},
+      {"hurdle", walker_course(hurdle_layout(), 5000)},
+      {"obstacle_course", walker_course(obstacle_course_layout(), 5000)},
+      {"patrol", walker_patrol},
   };
   return table;
 }

@@ -4,7 +4,7 @@
 
 #include <filesystem>
 
-#include "algorithms/evaluate.h"
+#include "hrl/evaluation.h"
 #include "algorithms/ppo.h"
 #include "environments/registry.h"
 

@@ -70,7 +70,7 @@ struct LoopRates {
 };
 
 LoopRates loop_rates(const SkillRecipe& s, int threads, int iterations, int frame_skip) {
-  set_torch_threads(threads);
+  set_torch_threads(1);  // as segue train: environments get the threads, LibTorch one
   VectorEnv envs(s.make_env, s.ppo.num_envs, threads);
   PPO ppo(s.ppo, s.net, envs, s.seed);
   const double physics_per_rollout = double(s.ppo.rollout_size()) * frame_skip;

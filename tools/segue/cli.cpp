@@ -39,7 +39,8 @@ Args::Args(const Command& cmd, int argc, char** argv) : cmd_(cmd) {
       positionals_.push_back(a);
     }
   }
-  if (positionals_.size() != cmd.positionals.size())
+  if (positionals_.size() < cmd.positionals.size() ||
+      positionals_.size() > cmd.positionals.size() + cmd.optional_positionals)
     throw Error("segue " + cmd.name + ": expected " + cmd.usage + " (see segue " + cmd.name + " --help)");
 }
 

@@ -20,6 +20,7 @@ struct Command {
   std::string name, usage, summary;
   std::vector<std::string> positionals;  // names, all required
   std::vector<Flag> flags;
+  size_t optional_positionals = 0;       // how many more positionals may follow
 };
 
 class Args {
@@ -28,6 +29,7 @@ class Args {
   Args(const Command& cmd, int argc, char** argv);
   bool help() const { return help_; }
   const std::string& positional(size_t i) const { return positionals_.at(i); }
+  size_t positional_count() const { return positionals_.size(); }
   bool has(const std::string& flag) const { return values_.count(flag) > 0; }
   std::string get(const std::string& flag, const std::string& fallback) const;
   int get_int(const std::string& flag, int fallback) const;
@@ -47,6 +49,7 @@ int train_main(int argc, char** argv);
 int eval_main(int argc, char** argv);
 int export_main(int argc, char** argv);
 int bench_main(int argc, char** argv);
+int report_main(int argc, char** argv);
 int render_main(int argc, char** argv);
 
 // Sets LibTorch's intra-op threads; 0 means every core.

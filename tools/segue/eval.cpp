@@ -1,9 +1,10 @@
-// segue eval POLICY --task NAME: success and return of a policy over seeded episodes.
+// segue eval: success and return over seeded episodes, for one policy on a task or for a
+// method (single, without-tp, ...) on a composite task.
 #include <cstdio>
 
-#include "algorithms/evaluate.h"
 #include "core/thread_pool.h"
 #include "environments/registry.h"
+#include "hrl/composite_recipe.h"
 #include "tools/segue/cli.h"
 
 namespace segue::cli {
@@ -11,17 +12,22 @@ namespace {
 
 const Command kEval{
     "eval",
-    "POLICY --task NAME [--episodes N] [--seed S] [--json]",
-    "Runs the deterministic policy (a checkpoint.pt or an exported .pt) for N episodes;\n"
-    "episode i starts from a seed derived from (S, i). Prints mean +- std of return,\n"
-    "success rate and success count.",
-    {"POLICY"},
-    {{"task", "NAME", "task to run (e.g. walker_forward)"},
+    "[POLICY] --task NAME [--method M] [--episodes N] [--seed S] [--json]",
+    "Runs deterministic policies for N episodes; episode i starts from a seed derived\n"
+    "from (S, i). With POLICY (a checkpoint.pt or an exported .pt) and no --method, runs\n"
+    "that policy on the task. With --method, runs a method of the paper on a composite\n"
+    "task with the recipe's (by default the shipped) policies: single, without-tp, tp,\n"
+    "lee, tp+q. Prints mean +- std of return, success rate and success count.",
+    {},
+    {{"task", "NAME", "task to run (e.g. walker_forward, hurdle)"},
+     {"method", "M", "composite-task method (single, without-tp, tp, lee, tp+q)"},
+     {"recipe", "FILE", "composite recipe (default experiments/TASK.yaml)"},
      {"episodes", "N", "number of episodes (default 50)"},
      {"seed", "S", "evaluation seed (default 0)"},
      {"json", "", "print one JSON object instead of text"},
-     {"set", "key=value", "override a task setting, e.g. --set env.push_prob=0 (repeatable)", true},
-     {"threads", "N", "threads stepping environments (default 0 = all cores)"}}};
+     {"set", "key=value", "override a recipe/task key, e.g. --set env.push_prob=0 (repeatable)", true},
+     {"threads", "N", "threads stepping environments (default 0 = all cores)"}},
+    1};
 
 }  // namespace
 
@@ -32,17 +38,41 @@ int eval_main(int argc, char** argv) {
     return 0;
   }
   if (!args.has("task")) throw Error("segue eval: --task NAME is required (see segue eval --help)");
-  const std::string path = args.positional(0), task = args.get("task", "");
+  const std::string task = args.get("task", "");
   const int episodes = args.get_int("episodes", 50);
   if (episodes <= 0) throw Error("segue eval: --episodes must be positive");
   const int seed = args.get_int("seed", 0);
-  Recipe settings = Recipe::parse("{}", "--set", args.all("set"));
-  auto make = task_factory(task, settings.root().sub("env"));
-  settings.reject_unknown();
-  Policy policy = Policy::load(path);
-  policy.check_fits(make()->spec(), path);
+  const int threads = resolve_threads(args.get_int("threads", 0));
   set_torch_threads(1);
-  EvalResult r = evaluate_policy(policy, make, episodes, uint64_t(seed), resolve_threads(args.get_int("threads", 0)));
+  const std::string method = args.get("method", "");
+  std::string label;
+  EnvFactory make;
+  ControllerFactory controllers;
+  CompositeRecipe composite;
+  if (!method.empty()) {
+    std::vector<std::string> sets = args.all("set");
+    if (args.positional_count() == 1) {
+      if (method != "single") throw Error("segue eval: a POLICY argument only goes with --method single");
+      sets.push_back("methods.single.policy=" + args.positional(0));
+    }
+    composite = CompositeRecipe::load(args.get("recipe", CompositeRecipe::default_file(task)), sets);
+    if (composite.task != task)
+      throw Error(composite.file + ": key 'task' is '" + composite.task + "', not '" + task + "'");
+    make = composite.make_env;
+    controllers = method_controllers(composite, method);
+    label = method;
+  } else {
+    if (args.positional_count() != 1) throw Error("segue eval: give a POLICY, or --method for a composite task");
+    const std::string path = args.positional(0);
+    Recipe settings = Recipe::parse("{}", "--set", args.all("set"));
+    make = task_factory(task, settings.root().sub("env"));
+    settings.reject_unknown();
+    Policy policy = Policy::load(path);
+    policy.check_fits(make()->spec(), path);
+    controllers = [policy] { return std::make_unique<PolicyController>(policy); };
+    label = path;
+  }
+  EvalResult r = evaluate(make, controllers, episodes, uint64_t(seed), threads);
 
   Summary ret = summarize(r.returns), count = summarize(r.success_counts);
   double success = summarize(std::vector<double>(r.successes.begin(), r.successes.end())).mean;
@@ -56,7 +86,7 @@ int eval_main(int argc, char** argv) {
       f.push_back({r.metric_names[k] + "_mean", summarize(r.metric_means[k]).mean});
     std::printf("%s\n", json_object(f).c_str());
   } else {
-    std::printf("%s on %s, %d episodes, seed %d\n", path.c_str(), task.c_str(), episodes, seed);
+    std::printf("%s on %s, %d episodes, seed %d\n", label.c_str(), task.c_str(), episodes, seed);
     std::printf("  return          %.2f +- %.2f\n", ret.mean, ret.std);
     std::printf("  success rate    %.2f\n", success);
     std::printf("  success count   %.2f +- %.2f\n", count.mean, count.std);

@@ -15,7 +15,8 @@ const char* kUsage =
     "Segue composes pretrained skills with transition policies (Byun & Perrault, ICLR 2022).\n\n"
     "commands:\n"
     "  train RECIPE       train a skill with PPO from a YAML recipe (resumes an interrupted run)\n"
-    "  eval POLICY        evaluate a checkpoint or exported policy on a task\n"
+    "  eval [POLICY]      evaluate a policy on a task, or a method on a composite task\n"
+    "  report TASK        evaluate methods over seeds; write experiments/results/TASK.{md,json}\n"
     "  export CKPT OUT    write a checkpoint's policy as TorchScript\n"
     "  render POLICY      render one episode of a policy to a video, headless\n"
     "  bench              measure physics, rollout and PPO throughput\n\n"
@@ -36,6 +37,7 @@ int main(int argc, char** argv) {
     if (cmd == "export") return segue::cli::export_main(argc - 2, argv + 2);
     if (cmd == "render") return segue::cli::render_main(argc - 2, argv + 2);
     if (cmd == "bench") return segue::cli::bench_main(argc - 2, argv + 2);
+    if (cmd == "report") return segue::cli::report_main(argc - 2, argv + 2);
     std::fprintf(stderr, "segue: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
     return 2;
   } catch (const segue::Error& e) {

@@ -6,7 +6,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "algorithms/evaluate.h"
+#include "hrl/evaluation.h"
 #include "algorithms/skill_recipe.h"
 #include "core/progress.h"
 #include "core/run_dir.h"
@@ -48,7 +48,10 @@ int train_main(int argc, char** argv) {
   recipe.reject_unknown();
 
   const int threads = resolve_threads(s.threads);
-  set_torch_threads(threads);
+  // LibTorch runs on one thread: the networks are too small to gain from more, and a
+  // fixed thread count keeps floating-point sums, and so the trained policy, the same
+  // whatever `threads` is. `threads` parallelises environment stepping only.
+  set_torch_threads(1);
   RunDir dir(s.run_dir, recipe.resolved_yaml());
   VectorEnv envs(s.make_env, s.ppo.num_envs, threads);
   PPO ppo(s.ppo, s.net, envs, s.seed);

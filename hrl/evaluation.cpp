@@ -1,4 +1,4 @@
-#include "algorithms/evaluate.h"
+#include "hrl/evaluation.h"
 
 #include <cmath>
 
@@ -17,11 +17,15 @@ Summary summarize(const std::vector<double>& xs) {
   return s;
 }
 
-EvalResult evaluate_policy(const Policy& policy, const std::function<std::unique_ptr<Env>()>& make,
-                           int episodes, uint64_t seed, int threads) {
+EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_controller, int episodes,
+                    uint64_t seed, int threads) {
   const int slots = std::max(1, std::min(episodes, 32));
   std::vector<std::unique_ptr<Env>> envs;
-  for (int i = 0; i < slots; ++i) envs.push_back(make());
+  std::vector<std::unique_ptr<Controller>> controllers;
+  for (int i = 0; i < slots; ++i) {
+    envs.push_back(make_env());
+    controllers.push_back(make_controller());
+  }
   const EnvSpec& spec = envs[0]->spec();
   const int D = spec.obs_dim, A = spec.act_dim, K = static_cast<int>(spec.metric_names.size());
 
@@ -34,25 +38,25 @@ EvalResult evaluate_policy(const Policy& policy, const std::function<std::unique
   r.metric_means.assign(K, std::vector<double>(episodes, 0.0));
 
   std::vector<float> obs(size_t(slots) * D), act(size_t(slots) * A);
-  std::vector<int> episode_of(slots, -1);
+  std::vector<int> episode_of(slots, -1);  // -1 idle, -2 just finished
   int next = 0;
   auto start = [&](int s) {
-    if (next >= episodes) {
-      episode_of[s] = -1;
-      return;
-    }
-    episode_of[s] = next;
-    envs[s]->reset(mix_seed(seed, next), &obs[size_t(s) * D]);
-    ++next;
+    episode_of[s] = next < episodes ? next++ : -1;
+    if (episode_of[s] < 0) return;
+    envs[s]->reset(mix_seed(seed, episode_of[s]), &obs[size_t(s) * D]);
+    controllers[s]->reset(*envs[s], &obs[size_t(s) * D]);
   };
   for (int s = 0; s < slots; ++s) start(s);
 
   ThreadPool pool(threads);
-  auto step_block = [&](int begin, int end) {
+  std::function<void(int, int)> step_block = [&](int begin, int end) {
     for (int s = begin; s < end; ++s) {
       int e = episode_of[s];
       if (e < 0) continue;
-      StepResult sr = envs[s]->step(&act[size_t(s) * A], &obs[size_t(s) * D]);
+      float* o = &obs[size_t(s) * D];
+      float* a = &act[size_t(s) * A];
+      controllers[s]->act(*envs[s], o, a);
+      StepResult sr = envs[s]->step(a, o);
       r.returns[e] += sr.reward;
       r.lengths[e] += 1;
       for (int k = 0; k < K; ++k) r.metric_means[k][e] += sr.info.metrics[k];
@@ -60,7 +64,7 @@ EvalResult evaluate_policy(const Policy& policy, const std::function<std::unique
         r.successes[e] = sr.info.success;
         r.success_counts[e] = sr.info.success_count;
         for (int k = 0; k < K; ++k) r.metric_means[k][e] /= r.lengths[e];
-        episode_of[s] = -2;  // finished; a new episode is started outside the parallel loop
+        episode_of[s] = -2;
       }
     }
   };
@@ -68,12 +72,16 @@ EvalResult evaluate_policy(const Policy& policy, const std::function<std::unique
     bool any = false;
     for (int s = 0; s < slots; ++s) any |= episode_of[s] >= 0;
     if (!any) break;
-    policy.act(obs.data(), slots, act.data());
     pool.parallel_for(slots, step_block);
     for (int s = 0; s < slots; ++s)
       if (episode_of[s] == -2) start(s);
   }
   return r;
+}
+
+EvalResult evaluate_policy(const Policy& policy, const EnvFactory& make_env, int episodes, uint64_t seed,
+                           int threads) {
+  return evaluate(make_env, [&] { return std::make_unique<PolicyController>(policy); }, episodes, seed, threads);
 }
 
 }  // namespace segue

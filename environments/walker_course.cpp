@@ -1,0 +1,127 @@
+#include "environments/walker_course.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace segue {
+
+WalkerCourse::WalkerCourse(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o,
+                           const Config& c)
+    : WalkerObstacleEnv(name, w, o, true), ccfg_(c) {
+  spec_.feature_names = {"curb_ahead", "curb_behind", "ceiling_ahead", "ceiling_behind"};
+  for (const auto& k : c.kinds) kinds_.push_back(k == "curb" ? ObstacleKind::Curb : ObstacleKind::Ceiling);
+}
+
+void WalkerCourse::reset_task() {
+  std::vector<ObstacleKind> order = kinds_;
+  if (ccfg_.shuffle) std::shuffle(order.begin(), order.end(), rng_.engine());
+  std::vector<Obstacle> layout;
+  for (size_t i = 0; i < order.size(); ++i) {
+    double start = ccfg_.positions[i] + rng_.symmetric(ccfg_.position_noise);
+    double length = order[i] == ObstacleKind::Curb ? ocfg_.curb_width : ocfg_.ceiling_length;
+    layout.push_back({order[i], start, start + length});
+  }
+  set_obstacles(layout);
+  WalkerEnv::reset_task();
+}
+
+bool WalkerCourse::near_ceiling() const {
+  double x = min_x();
+  for (const auto& o : obstacles_)
+    if (o.kind == ObstacleKind::Ceiling && x > o.start - ccfg_.ceiling_zone && x < o.end + ccfg_.ceiling_zone)
+      return true;
+  return false;
+}
+
+void WalkerCourse::features(double* out) const {
+  double x = min_x();
+  out[0] = out[1] = out[2] = out[3] = kFar;
+  // Next obstacle whose start is ahead, and the last whose end is behind.
+  for (const auto& o : obstacles_)
+    if (o.start > x) {
+      out[o.kind == ObstacleKind::Curb ? 0 : 2] = o.start - x;
+      break;
+    }
+  for (auto it = obstacles_.rbegin(); it != obstacles_.rend(); ++it)
+    if (it->end < x) {
+      out[it->kind == ObstacleKind::Curb ? 1 : 3] = x - it->end;
+      break;
+    }
+}
+
+StepResult WalkerCourse::evaluate(const float* action) {
+  StepResult r;
+  bool ceiling = near_ceiling();
+  double v = x_velocity();
+  r.reward = walk_reward(v, action, 1.0, ceiling ? 0.0 : 1.0);
+  bool contact = touching();
+  if (contact) r.reward -= ocfg_.contact_penalty;
+  r.reward += ccfg_.pass_bonus * update_passed();
+  bool fell = torso_z() < (ceiling ? ccfg_.ceiling_fall_height : cfg_.fall_height);
+  bool all = passed_ == int(obstacles_.size());
+  r.terminated = fell || contact || all;
+  r.info.success = all;
+  r.info.success_count = passed_;
+  r.info.metrics[0] = v;
+  return r;
+}
+
+// ---- patrol ----------------------------------------------------------------------------
+
+WalkerPatrol::WalkerPatrol(const std::string& name, const WalkerConfig& w, const Config& c)
+    : WalkerEnv(name, w, "walker/walker_patrol.xml"), pcfg_(c) {
+  spec_.obs_dim = kBaseObsDim + 1;
+  spec_.feature_names = {"direction", "since_turn", "progress"};
+}
+
+void WalkerPatrol::reset_task() {
+  direction_ = rng_.bernoulli(0.5) ? 1 : -1;
+  turns_ = 0;
+  since_turn_ = 0;
+  WalkerEnv::reset_task();
+  turn_x_ = torso_x();
+}
+
+void WalkerPatrol::features(double* out) const {
+  out[0] = direction_;
+  out[1] = turns_ > 0 ? since_turn_ : 1e6;
+  out[2] = direction_ * (torso_x() - turn_x_);
+}
+
+StepResult WalkerPatrol::evaluate(const float* action) {
+  StepResult r;
+  double v = x_velocity();
+  r.reward = walk_reward(direction_ * v, action, 1.0, 1.0);
+  ++since_turn_;
+  if (direction_ * torso_x() > pcfg_.stone_x) {  // passed the target stone
+    ++turns_;
+    r.reward += pcfg_.turn_bonus;
+    direction_ = -direction_;
+    since_turn_ = 0;
+    turn_x_ = torso_x();
+  }
+  r.terminated = fallen() || turns_ >= pcfg_.max_turns;
+  r.info.success = turns_ >= pcfg_.max_turns;
+  r.info.success_count = turns_;
+  r.info.metrics[0] = v;
+  return r;
+}
+
+void WalkerPatrol::observe(float* obs) const {
+  WalkerEnv::observe(obs);
+  obs[kBaseObsDim] = static_cast<float>(direction_ * pcfg_.stone_x - torso_x());
+}
+
+void WalkerPatrol::save_task_state(std::vector<double>& out) const {
+  out.insert(out.end(), {double(direction_), double(turns_), double(since_turn_), turn_x_});
+}
+
+void WalkerPatrol::restore_task_state(const double* in, size_t n) {
+  if (n < 4) throw Error(spec_.name + ": saved state lacks the patrol state");
+  direction_ = int(in[0]);
+  turns_ = int(in[1]);
+  since_turn_ = int(in[2]);
+  turn_x_ = in[3];
+}
+
+}  // namespace segue

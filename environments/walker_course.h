@@ -1,0 +1,72 @@
+#pragma once
+// Hurdle and Obstacle course: the walker crosses a row of curbs and ceilings. Both are
+// this one class with a different layout (recipe `env:` keys), as the spec describes:
+//   Hurdle:          curbs at 8, 18, ..., 48 (+ U(position_noise))
+//   Obstacle course: 3 curbs and 2 ceilings in random order at 8, 19, ..., 52 (+ U(0.5))
+// An obstacle counts when x is pass_margin past its end. The episode ends on a fall, on
+// touching an obstacle, or when every obstacle is passed.
+#include "environments/walker_obstacles.h"
+
+namespace segue {
+
+class WalkerCourse : public WalkerObstacleEnv {
+ public:
+  struct Config {
+    std::vector<double> positions;       // obstacle start x
+    double position_noise = 0.5;         // + U(position_noise) each
+    std::vector<std::string> kinds;      // "curb" or "ceiling" per obstacle
+    bool shuffle = false;                // random order of `kinds` each episode
+    double pass_bonus = 10.0;            // reward per obstacle passed
+    double ceiling_zone = 3.0;           // within this of a ceiling, only a torso below
+    double ceiling_fall_height = 0.3;    //   ceiling_fall_height is a fall (crawling is low)
+  };
+  WalkerCourse(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
+
+  // Features: curb_ahead / ceiling_ahead (metres from x to the next obstacle's start when
+  // it is of that kind, else "far"), curb_behind / ceiling_behind (metres past the end of
+  // the last obstacle behind x when of that kind, else far).
+  void features(double* out) const override;
+  static constexpr double kFar = 1e6;
+
+ protected:
+  void reset_task() override;
+  StepResult evaluate(const float* action) override;
+
+ private:
+  bool near_ceiling() const;
+  Config ccfg_;
+  std::vector<ObstacleKind> kinds_;
+};
+
+// Patrol: touch the stones at +-stone_x alternately. A turn counts when the torso passes
+// the target stone in the current direction; the direction then flips. Starts in a
+// random direction. Observation: the 26 walker numbers + (target stone x - torso x).
+class WalkerPatrol : public WalkerEnv {
+ public:
+  struct Config {
+    double stone_x = 2.0;
+    int max_turns = 5;
+    double turn_bonus = 10.0;
+  };
+  WalkerPatrol(const std::string& name, const WalkerConfig& w, const Config& c);
+
+  // Features: direction (+1 / -1), since_turn (control steps since the last turn, far
+  // before the first), progress (metres walked in the current direction since the turn).
+  void features(double* out) const override;
+  int direction() const { return direction_; }
+  int turns() const { return turns_; }
+
+ protected:
+  void reset_task() override;
+  StepResult evaluate(const float* action) override;
+  void observe(float* obs) const override;
+  void save_task_state(std::vector<double>& out) const override;
+  void restore_task_state(const double* in, size_t n) override;
+
+ private:
+  Config pcfg_;
+  int direction_ = 1, turns_ = 0, since_turn_ = 0;
+  double turn_x_ = 0.0;
+};
+
+}  // namespace segue

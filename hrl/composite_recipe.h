@@ -1,0 +1,51 @@
+#pragma once
+// A composite task recipe (experiments/<task>.yaml): the task, its skills, the
+// meta-controller's rules (start skill, transition intervals) and the artefacts of each
+// method. Adding a composite task means a recipe and a small task class; nothing here.
+//
+//   task: hurdle
+//   env: {}
+//   skills:
+//     walk: {policy: assets/policies/walker/walker_forward.pt}
+//     jump: {policy: assets/policies/walker/walker_jump.pt}
+//   start: [{skill: walk}]
+//   transitions:
+//     - {from: walk, to: jump, when: {curb_ahead: [3, 4]}}
+//     - {from: jump, to: walk, when: {curb_behind: [2.5, 3.5]}}
+//   methods:
+//     single: {policy: assets/policies/walker/single/hurdle.pt}
+//   eval: {episodes: 50, seeds: [0, 1, 2]}
+#include <string>
+#include <vector>
+
+#include "core/recipe.h"
+#include "hrl/evaluation.h"
+#include "hrl/meta_controller.h"
+#include "hrl/skill.h"
+
+namespace segue {
+
+struct CompositeRecipe {
+  std::string file, task;
+  EnvFactory make_env;
+  EnvSpec spec;
+  std::vector<Skill> skills;
+  MetaController meta;
+  std::string single_policy;  // methods.single.policy ("" when absent)
+  int eval_episodes = 50;
+  std::vector<int> eval_seeds{0, 1, 2};
+
+  // Reads and validates everything (missing skills or policies, sizes that do not fit),
+  // then refuses unknown keys.
+  static CompositeRecipe load(const std::string& file, const std::vector<std::string>& overrides = {});
+  // The recipe for a task name: experiments/<task>.yaml in the source tree.
+  static std::string default_file(const std::string& task);
+};
+
+// Method names from the paper: single, without-tp, tp, lee, tp+q.
+const std::vector<std::string>& method_names();
+// Controllers for `method` on this recipe; throws segue::Error when the method's
+// artefacts are not available.
+ControllerFactory method_controllers(const CompositeRecipe& recipe, const std::string& method);
+
+}  // namespace segue

@@ -1,0 +1,35 @@
+#pragma once
+// Evaluation episodes. Episode i always starts from seed mix_seed(seed, i), so results do
+// not depend on how many environments run side by side or on how many threads step them.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/env.h"
+#include "hrl/controller.h"
+
+namespace segue {
+
+struct EvalResult {
+  std::vector<double> returns, success_counts, lengths;
+  std::vector<uint8_t> successes;
+  std::vector<std::string> metric_names;
+  std::vector<std::vector<double>> metric_means;  // [metric][episode]: per-step mean
+};
+
+struct Summary {
+  double mean = 0, std = 0;
+};
+Summary summarize(const std::vector<double>& xs);  // population std, as numpy's default
+
+using EnvFactory = std::function<std::unique_ptr<Env>()>;
+using ControllerFactory = std::function<std::unique_ptr<Controller>()>;
+
+EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_controller, int episodes,
+                    uint64_t seed, int threads);
+// The common case: one deterministic policy.
+EvalResult evaluate_policy(const Policy& policy, const EnvFactory& make_env, int episodes, uint64_t seed,
+                           int threads);
+
+}  // namespace segue

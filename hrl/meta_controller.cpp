@@ -1,0 +1,67 @@
+#include "hrl/meta_controller.h"
+
+#include <algorithm>
+
+namespace segue {
+namespace {
+
+int find_skill(const Section& s, const std::string& key, const std::vector<Skill>& skills) {
+  std::string name = s.require<std::string>(key);
+  int i = skill_index(skills, name);
+  if (i < 0) {
+    std::string known;
+    for (const auto& k : skills) known += (known.empty() ? "" : ", ") + k.name;
+    throw s.error(key, "no skill named '" + name + "' (skills: " + known + ")");
+  }
+  return i;
+}
+
+std::vector<Condition> read_when(const Section& s, const std::vector<std::string>& features) {
+  std::vector<Condition> when;
+  if (!s.has("when")) return when;
+  Section w = s.sub("when");
+  for (const auto& name : w.keys()) {
+    auto it = std::find(features.begin(), features.end(), name);
+    if (it == features.end()) {
+      std::string known;
+      for (const auto& f : features) known += (known.empty() ? "" : ", ") + f;
+      throw w.error(name, "the task has no feature '" + name + "' (features: " + known + ")");
+    }
+    std::vector<double> range = w.is_sequence(name) ? w.require<std::vector<double>>(name)
+                                                    : std::vector<double>(2, w.require<double>(name));
+    if (range.size() != 2 || range[0] > range[1]) throw w.error(name, "expects [lo, hi] with lo <= hi");
+    when.push_back({int(it - features.begin()), range[0], range[1]});
+  }
+  return when;
+}
+
+}  // namespace
+
+MetaController::MetaController(const Section& root, const std::vector<Skill>& skills,
+                               const std::vector<std::string>& features) {
+  for (const Section& rule : root.items("start"))
+    start_.push_back({find_skill(rule, "skill", skills), read_when(rule, features)});
+  if (start_.empty()) throw root.error("start", "lists no start skill");
+  for (const Section& t : root.items("transitions"))
+    transitions_.push_back({find_skill(t, "from", skills), find_skill(t, "to", skills), read_when(t, features)});
+}
+
+bool MetaController::holds(const std::vector<Condition>& when, const double* f) {
+  for (const auto& c : when)
+    if (f[c.feature] < c.lo || f[c.feature] > c.hi) return false;
+  return true;
+}
+
+int MetaController::start_skill(const double* f) const {
+  for (const auto& [skill, when] : start_)
+    if (holds(when, f)) return skill;
+  return start_.front().first;
+}
+
+int MetaController::active_transition(int skill, const double* f) const {
+  for (size_t i = 0; i < transitions_.size(); ++i)
+    if (transitions_[i].from == skill && holds(transitions_[i].when, f)) return static_cast<int>(i);
+  return -1;
+}
+
+}  // namespace segue

@@ -1,0 +1,49 @@
+#pragma once
+// The rule-based meta-controller. A composite recipe declares, over the task's named
+// features, which skill starts an episode and each transition's interval:
+//
+//   start:
+//     - {skill: walk}
+//   transitions:
+//     - {from: walk, to: jump, when: {curb_ahead: [3, 4]}}      # 3-4 m before a curb
+//     - {from: jump, to: walk, when: {curb_behind: [2.5, 3.5]}}
+//
+// `when` maps features to closed ranges [lo, hi] (a single number means equality); all
+// must hold. A transition a->b is "in its interval" while its conditions hold and the
+// current skill is a. Nothing here knows any particular task.
+#include <string>
+#include <vector>
+
+#include "core/recipe.h"
+#include "hrl/skill.h"
+
+namespace segue {
+
+struct Condition {
+  int feature;
+  double lo, hi;
+};
+
+struct Transition {
+  int from, to;
+  std::vector<Condition> when;
+};
+
+class MetaController {
+ public:
+  MetaController() = default;
+  MetaController(const Section& root, const std::vector<Skill>& skills,
+                 const std::vector<std::string>& feature_names);
+  // The first start rule that holds (or the first rule when none does).
+  int start_skill(const double* features) const;
+  // The index of the transition out of `skill` whose interval holds now, or -1.
+  int active_transition(int skill, const double* features) const;
+  const std::vector<Transition>& transitions() const { return transitions_; }
+
+ private:
+  static bool holds(const std::vector<Condition>& when, const double* f);
+  std::vector<std::pair<int, std::vector<Condition>>> start_;
+  std::vector<Transition> transitions_;
+};
+
+}  // namespace segue

@@ -1,0 +1,55 @@
+#include "hrl/skill.h"
+
+#include <filesystem>
+
+#include "core/assets.h"
+
+namespace segue {
+
+namespace {
+// Relative policy paths are looked up from the working directory, then from the source tree.
+std::string resolve(const std::string& path) {
+  if (std::filesystem::exists(path) || std::filesystem::path(path).is_absolute()) return path;
+  std::string in_tree = std::string(SEGUE_SOURCE_DIR) + "/" + path;
+  return std::filesystem::exists(in_tree) ? in_tree : path;
+}
+}  // namespace
+
+std::vector<Skill> read_skills(const Section& section, const EnvSpec& task) {
+  std::vector<Skill> skills;
+  for (const auto& name : section.keys()) {
+    Section s = section.sub(name);
+    Skill k;
+    k.name = name;
+    std::string file = s.require<std::string>("policy");
+    k.policy_path = resolve(file);
+    if (!std::filesystem::exists(k.policy_path))
+      throw s.error("policy", "no such policy file '" + file + "'");
+    try {
+      k.policy = Policy::load(k.policy_path);
+    } catch (const Error& e) {
+      throw s.error("policy", e.what());
+    }
+    std::vector<int> slice = s.get("obs", std::vector<int>{0, k.policy.obs_dim()});
+    if (slice.size() != 2 || slice[0] < 0 || slice[1] > task.obs_dim || slice[1] - slice[0] != k.policy.obs_dim())
+      throw s.error("obs", "policy '" + file + "' takes " + std::to_string(k.policy.obs_dim()) +
+                               " observation numbers; the slice must be [begin, end) within task '" +
+                               task.name + "''s " + std::to_string(task.obs_dim));
+    if (k.policy.act_dim() != task.act_dim)
+      throw s.error("policy", "'" + file + "' acts in " + std::to_string(k.policy.act_dim()) +
+                                  " dimensions, task '" + task.name + "' in " + std::to_string(task.act_dim));
+    k.obs_begin = slice[0];
+    k.obs_end = slice[1];
+    skills.push_back(std::move(k));
+  }
+  if (skills.empty()) throw section.error("", "names no skills");
+  return skills;
+}
+
+int skill_index(const std::vector<Skill>& skills, const std::string& name) {
+  for (size_t i = 0; i < skills.size(); ++i)
+    if (skills[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+}  // namespace segue

@@ -1,0 +1,219 @@
+// Composite walker tasks and the meta-controller: success counts increment exactly once
+// per obstacle or turn, features match hand-computed distances, and the rule-based
+// meta-controller walks through the documented skill sequence.
+#include <gtest/gtest.h>
+
+#include "environments/registry.h"
+#include "environments/walker_course.h"
+#include "hrl/meta_controller.h"
+
+namespace segue {
+namespace {
+
+std::unique_ptr<Env> make(const std::string& task, const std::string& env = "{}") {
+  static std::vector<Recipe> keep;
+  keep.push_back(Recipe::parse("{env: " + env + "}", "test"));
+  return task_factory(task, keep.back().root().sub("env"))();
+}
+
+const float kZero[6] = {0, 0, 0, 0, 0, 0};
+
+// Teleports the walker to torso x and takes one step with zero action, upright.
+StepResult step_at(Env& env, double x, std::vector<float>& obs) {
+  auto& m = dynamic_cast<MujocoEnv&>(env);
+  m.mutable_data()->qpos[0] = x;
+  m.mutable_data()->qpos[1] = 1.25;
+  m.mutable_data()->qpos[2] = 0;
+  for (int i = 3; i < 9; ++i) m.mutable_data()->qpos[i] = 0;  // standing straight
+  for (int i = 0; i < 9; ++i) m.mutable_data()->qvel[i] = 0;
+  m.forward(obs.data());
+  return env.step(kZero, obs.data());
+}
+
+}  // namespace
+
+TEST(Hurdle, CountsEachCurbOnceAtOnePointFiveMetresPastItsEnd) {
+  auto env = make("hurdle", "{position_noise: 0, push_prob: 0}");
+  auto& course = dynamic_cast<WalkerCourse&>(*env);
+  std::vector<float> obs(28);
+  env->reset(0, obs.data());
+  ASSERT_EQ(course.obstacles().size(), 5u);
+  EXPECT_DOUBLE_EQ(course.obstacles()[2].start, 28.0);
+  EXPECT_DOUBLE_EQ(course.obstacles()[2].end, 28.2);
+  int count = 0;
+  // Walk the torso forward in 0.25 m hops, staying off the curbs (a hop onto a curb
+  // would be a contact). min_x is the torso's x here: the feet point forward.
+  for (double x = 0.5; x < 50.0; x += 0.25) {
+    bool on_curb = false;
+    for (const auto& o : course.obstacles()) on_curb |= x > o.start - 0.3 && x < o.end + 0.1;
+    if (on_curb) continue;
+    StepResult r = step_at(*env, x, obs);
+    ASSERT_FALSE(r.terminated && r.info.success_count < 5) << "x " << x;
+    int expected = 0;
+    for (const auto& o : course.obstacles()) expected += course.min_x() > o.end + 1.5;
+    ASSERT_EQ(r.info.success_count, expected) << "x " << x;
+    ASSERT_LE(r.info.success_count - count, 1) << "x " << x;
+    count = r.info.success_count;
+    if (r.done()) break;
+  }
+  EXPECT_EQ(count, 5);
+}
+
+TEST(Hurdle, FeaturesAreDistancesToCurbs) {
+  auto env = make("hurdle", "{position_noise: 0, push_prob: 0}");
+  std::vector<float> obs(28);
+  env->reset(0, obs.data());
+  step_at(*env, 4.5, obs);
+  auto& course = dynamic_cast<WalkerCourse&>(*env);
+  double x = course.min_x(), f[4];
+  env->features(f);
+  EXPECT_NEAR(f[0], 8.0 - x, 1e-9);         // curb_ahead
+  EXPECT_EQ(f[1], WalkerCourse::kFar);       // nothing behind yet
+  EXPECT_EQ(f[2], WalkerCourse::kFar);       // no ceilings in Hurdle
+  step_at(*env, 11.0, obs);
+  x = course.min_x();
+  env->features(f);
+  EXPECT_NEAR(f[0], 18.0 - x, 1e-9);
+  EXPECT_NEAR(f[1], x - 8.2, 1e-9);          // curb_behind
+}
+
+TEST(ObstacleCourse, ThreeCurbsAndTwoCeilingsInASeededOrder) {
+  auto a = make("obstacle_course"), b = make("obstacle_course");
+  std::vector<float> obs(28);
+  std::vector<std::vector<int>> orders;
+  for (uint64_t seed : {1, 2, 3, 4, 5, 6}) {
+    a->reset(seed, obs.data());
+    auto& course = dynamic_cast<WalkerCourse&>(*a);
+    std::vector<int> kinds;
+    int curbs = 0;
+    for (const auto& o : course.obstacles()) {
+      kinds.push_back(int(o.kind));
+      curbs += o.kind == ObstacleKind::Curb;
+      EXPECT_NEAR(o.end - o.start, o.kind == ObstacleKind::Curb ? 0.2 : 3.0, 1e-12);
+    }
+    EXPECT_EQ(curbs, 3);
+    orders.push_back(kinds);
+    b->reset(seed, obs.data());
+    auto& same = dynamic_cast<WalkerCourse&>(*b);
+    for (size_t i = 0; i < 5; ++i) EXPECT_EQ(same.obstacles()[i].start, course.obstacles()[i].start);
+  }
+  bool varied = false;
+  for (const auto& o : orders) varied |= o != orders[0];
+  EXPECT_TRUE(varied) << "six seeds gave one obstacle order";
+}
+
+TEST(Patrol, CountsATurnOncePerStoneAndFlipsDirection) {
+  auto env = make("patrol", "{push_prob: 0}");
+  auto& patrol = dynamic_cast<WalkerPatrol&>(*env);
+  std::vector<float> obs(27);
+  // Find a seed that starts forward, for a readable script.
+  uint64_t seed = 0;
+  do env->reset(++seed, obs.data());
+  while (patrol.direction() != 1);
+  EXPECT_NEAR(obs[26], 2.0 - patrol.torso_x(), 1e-6);  // signed distance to the +2 stone
+  StepResult r = step_at(*env, 1.5, obs);
+  EXPECT_EQ(r.info.success_count, 0);
+  r = step_at(*env, 2.2, obs);
+  EXPECT_EQ(r.info.success_count, 1);
+  EXPECT_EQ(patrol.direction(), -1);
+  double f[3];
+  env->features(f);
+  EXPECT_EQ(f[0], -1);
+  EXPECT_EQ(f[1], 0);  // since_turn
+  r = step_at(*env, 2.5, obs);  // further out: no second count
+  EXPECT_EQ(r.info.success_count, 1);
+  r = step_at(*env, -2.1, obs);
+  EXPECT_EQ(r.info.success_count, 2);
+  EXPECT_EQ(patrol.direction(), 1);
+}
+
+TEST(MetaController, HurdleSkillSequenceOnAScriptedEpisode) {
+  Recipe recipe = Recipe::parse(R"(
+start: [{skill: walk}]
+transitions:
+  - {from: walk, to: jump, when: {curb_ahead: [3, 4]}}
+  - {from: jump, to: walk, when: {curb_behind: [2.5, 3.5]}})",
+                                "hurdle-rules");
+  std::vector<Skill> skills(2);
+  skills[0].name = "walk";
+  skills[1].name = "jump";
+  auto env = make("hurdle", "{position_noise: 0, push_prob: 0}");
+  MetaController meta(recipe.root(), skills, env->spec().feature_names);
+  std::vector<float> obs(28);
+  env->reset(0, obs.data());
+  double f[4];
+  env->features(f);
+  int skill = meta.start_skill(f);
+  std::vector<std::pair<double, int>> switches;  // (x, new skill)
+  for (double x = 0.5; x < 32.0; x += 0.1) {
+    bool on_curb = false;
+    for (double c : {8.0, 18.0, 28.0}) on_curb |= x > c - 0.3 && x < c + 0.3;
+    if (on_curb) continue;
+    step_at(*env, x, obs);
+    env->features(f);
+    int t = meta.active_transition(skill, f);
+    if (t >= 0) {
+      skill = meta.transitions()[t].to;
+      switches.push_back({x, skill});
+    }
+  }
+  // walk -> jump when the curb is 4 m ahead; jump -> walk 2.5 m after its end.
+  ASSERT_EQ(switches.size(), 6u);
+  const double curbs[3] = {8.0, 18.0, 28.0};
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(switches[2 * k].second, 1);
+    EXPECT_NEAR(switches[2 * k].first, curbs[k] - 4.0, 0.11);
+    EXPECT_EQ(switches[2 * k + 1].second, 0);
+    EXPECT_NEAR(switches[2 * k + 1].first, curbs[k] + 0.2 + 2.5, 0.11);
+  }
+}
+
+TEST(MetaController, PatrolStartsByDirectionAndBalancesBetweenWalks) {
+  Recipe recipe = Recipe::parse(R"(
+start: [{skill: forward, when: {direction: 1}}, {skill: backward, when: {direction: -1}}]
+transitions:
+  - {from: forward, to: balance, when: {since_turn: [0, 100]}}
+  - {from: backward, to: balance, when: {since_turn: [0, 100]}}
+  - {from: balance, to: forward, when: {direction: 1, since_turn: [100, 1.0e+6], progress: [-1.0e+6, 4]}}
+  - {from: balance, to: backward, when: {direction: -1, since_turn: [100, 1.0e+6], progress: [-1.0e+6, 4]}})",
+                                "patrol-rules");
+  std::vector<Skill> skills(3);
+  skills[0].name = "forward";
+  skills[1].name = "backward";
+  skills[2].name = "balance";
+  MetaController meta(recipe.root(), skills, {"direction", "since_turn", "progress"});
+  double f[3] = {-1, 1e6, 0};
+  EXPECT_EQ(meta.start_skill(f), 1);
+  f[0] = 1;
+  EXPECT_EQ(meta.start_skill(f), 0);
+  EXPECT_EQ(meta.active_transition(0, f), -1);  // walking, no turn yet
+  // Turn at the stone: direction flips to -1, since_turn = 0.
+  double g[3] = {-1, 0, 0};
+  int t = meta.active_transition(0, g);
+  ASSERT_GE(t, 0);
+  EXPECT_EQ(meta.transitions()[t].to, 2);        // balance
+  g[1] = 50;
+  EXPECT_EQ(meta.active_transition(2, g), -1);  // still balancing
+  g[1] = 100;
+  t = meta.active_transition(2, g);
+  ASSERT_GE(t, 0);
+  EXPECT_EQ(meta.transitions()[t].to, 1);        // walk backward, the new direction
+  g[2] = 4.5;                                    // walked more than 4 m: the interval is over
+  EXPECT_EQ(meta.active_transition(2, g), -1);
+}
+
+TEST(MetaController, RefusesUnknownSkillsAndFeatures) {
+  std::vector<Skill> skills(1);
+  skills[0].name = "walk";
+  Recipe bad_skill = Recipe::parse("start: [{skill: run}]", "r.yaml");
+  try {
+    MetaController(bad_skill.root(), skills, {"curb_ahead"});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "r.yaml: key 'start.0.skill': no skill named 'run' (skills: walk)");
+  }
+  Recipe bad_feature = Recipe::parse("start: [{skill: walk, when: {hurdle_ahead: [1, 2]}}]", "r.yaml");
+  EXPECT_THROW(MetaController(bad_feature.root(), skills, {"curb_ahead"}), Error);
+}
+
+}  // namespace segue
