@@ -10,64 +10,55 @@ int resolve_threads(int requested) {
 }
 
 ThreadPool::ThreadPool(int threads) {
-  for (int i = 1; i < std::max(1, threads); ++i) workers_.emplace_back([this, i] { work(i); });
+  for (int i = 1; i < std::max(1, threads); ++i) workers_.emplace_back([this] { work(); });
 }
 
 ThreadPool::~ThreadPool() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
+    generation_.fetch_add(1);
   }
   start_.notify_all();
   for (auto& w : workers_) w.join();
 }
 
-static void block(int n, int parts, int index, int& begin, int& end) {
-  begin = static_cast<int>(static_cast<long>(n) * index / parts);
-  end = static_cast<int>(static_cast<long>(n) * (index + 1) / parts);
+void ThreadPool::drain() {
+  for (int i = next_.fetch_add(1); i < n_; i = next_.fetch_add(1)) (*job_)(i, i + 1);
 }
 
 void ThreadPool::parallel_for(int n, const std::function<void(int, int)>& fn) {
   if (workers_.empty() || n <= 1) {
-    fn(0, n);
+    for (int i = 0; i < n; ++i) fn(i, i + 1);
     return;
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
     job_ = &fn;
     n_ = n;
-    pending_ = static_cast<int>(workers_.size());
-    ++generation_;
+    next_.store(0);
+    busy_.store(static_cast<int>(workers_.size()));
+    generation_.fetch_add(1);
   }
   start_.notify_all();
-  int begin, end;
-  block(n, size(), 0, begin, end);
-  if (begin < end) fn(begin, end);
-  std::unique_lock<std::mutex> lock(mutex_);
-  finished_.wait(lock, [this] { return pending_ == 0; });
-  job_ = nullptr;
+  drain();
+  while (busy_.load(std::memory_order_acquire) > 0) std::this_thread::yield();
 }
 
-void ThreadPool::work(int index) {
-  long seen = 0;
+void ThreadPool::work() {
+  long seen = generation_.load();
   for (;;) {
-    const std::function<void(int, int)>* job;
-    int n;
+    // Spin a little for the next job, then sleep.
+    for (int spin = 0; spin < 20000 && generation_.load(std::memory_order_acquire) == seen; ++spin)
+      std::this_thread::yield();
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      start_.wait(lock, [&] { return stop_ || generation_ != seen; });
+      start_.wait(lock, [&] { return generation_.load() != seen; });
       if (stop_) return;
-      seen = generation_;
-      job = job_;
-      n = n_;
+      seen = generation_.load();
     }
-    int begin, end;
-    block(n, size(), index, begin, end);
-    if (begin < end) (*job)(begin, end);
-    {
-      std::lock_guard<std::mutex> lock(mutex_);
-      if (--pending_ == 0) finished_.notify_one();
-    }
+    drain();
+    busy_.fetch_sub(1, std::memory_order_release);
   }
 }
 

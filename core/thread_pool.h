@@ -1,7 +1,10 @@
 #pragma once
-// A fixed pool of workers for data-parallel loops. parallel_for splits [0, n) into one
-// contiguous block per thread (the caller works the first block), so which thread steps
-// which environment never changes a result.
+// A fixed pool of workers for data-parallel loops over independent items (environments).
+// Items are handed out one at a time from an atomic counter, so a slow item (an episode
+// reset, a contact-heavy step) does not leave the other threads idle; which thread runs
+// which item never changes a result. Between jobs, workers spin briefly before sleeping:
+// a vector step is a few hundred microseconds, comparable to a futex wake-up.
+#include <atomic>
 #include <condition_variable>
 #include <functional>
 #include <mutex>
@@ -17,18 +20,20 @@ class ThreadPool {
   ThreadPool(const ThreadPool&) = delete;
   ThreadPool& operator=(const ThreadPool&) = delete;
   int size() const { return static_cast<int>(workers_.size()) + 1; }
-  // Calls fn(begin, end) on disjoint blocks covering [0, n) and waits for all of them.
+  // Calls fn(i, i + 1) for every i in [0, n) and waits for all of them.
   void parallel_for(int n, const std::function<void(int, int)>& fn);
 
  private:
-  void work(int index);
+  void work();
+  void drain();
   std::vector<std::thread> workers_;
   std::mutex mutex_;
-  std::condition_variable start_, finished_;
+  std::condition_variable start_;
   const std::function<void(int, int)>* job_ = nullptr;
   int n_ = 0;
-  long generation_ = 0;
-  int pending_ = 0;
+  std::atomic<int> next_{0};
+  std::atomic<int> busy_{0};        // workers still inside the current job
+  std::atomic<long> generation_{0};
   bool stop_ = false;
 };
 

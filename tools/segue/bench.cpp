@@ -26,8 +26,8 @@ const Command kBench{
     {},
     {{"json", "", "print one JSON object"},
      {"recipe", "FILE", "skill recipe whose settings to use (default experiments/primitives/walker_forward.yaml)"},
-     {"iterations", "K", "PPO iterations per measurement (default 3)"},
-     {"steps", "N", "physics steps for the raw measurements (default 40000)"}}};
+     {"iterations", "K", "PPO iterations per measurement (default 5)"},
+     {"steps", "N", "physics steps for the raw measurements (default 100000)"}}};
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -97,7 +97,7 @@ int bench_main(int argc, char** argv) {
     return 0;
   }
   std::string recipe_path = args.get("recipe", std::string(SEGUE_SOURCE_DIR) + "/experiments/primitives/walker_forward.yaml");
-  const int iterations = args.get_int("iterations", 3), steps = args.get_int("steps", 40000);
+  const int iterations = args.get_int("iterations", 5), steps = args.get_int("steps", 100000);
   if (iterations <= 0 || steps <= 0) throw Error("segue bench: --iterations and --steps must be positive");
   Recipe recipe = Recipe::load(recipe_path);
   SkillRecipe s = SkillRecipe::read(recipe, "runs/bench");
