@@ -10,7 +10,8 @@ int resolve_threads(int requested) {
 }
 
 ThreadPool::ThreadPool(int threads) {
-  for (int i = 1; i < std::max(1, threads); ++i) workers_.emplace_back([this] { work(); });
+  // Workers start from generation 0: a job posted before a thread first runs is still seen.
+  for (int i = 1; i < std::max(1, threads); ++i) workers_.emplace_back([this] { work(0); });
 }
 
 ThreadPool::~ThreadPool() {
@@ -45,8 +46,7 @@ void ThreadPool::parallel_for(int n, const std::function<void(int, int)>& fn) {
   while (busy_.load(std::memory_order_acquire) > 0) std::this_thread::yield();
 }
 
-void ThreadPool::work() {
-  long seen = generation_.load();
+void ThreadPool::work(long seen) {
   for (;;) {
     // Spin a little for the next job, then sleep.
     for (int spin = 0; spin < 20000 && generation_.load(std::memory_order_acquire) == seen; ++spin)

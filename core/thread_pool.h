@@ -24,7 +24,7 @@ class ThreadPool {
   void parallel_for(int n, const std::function<void(int, int)>& fn);
 
  private:
-  void work();
+  void work(long seen);
   void drain();
   std::vector<std::thread> workers_;
   std::mutex mutex_;

@@ -183,3 +183,21 @@ TEST(VectorEnv, ResultsDoNotDependOnThreadCount) {
 }
 
 }  // namespace segue
+
+namespace segue {
+
+TEST(ThreadPool, EveryItemOnceEvenWhenJobsArriveBeforeWorkersStart) {
+  for (int round = 0; round < 200; ++round) {
+    ThreadPool pool(2);  // a job posted at once, before the worker has run
+    std::vector<int> hits(37, 0);
+    pool.parallel_for(37, [&](int b, int e) {
+      for (int i = b; i < e; ++i) hits[i] += 1;
+    });
+    pool.parallel_for(5, [&](int b, int e) {
+      for (int i = b; i < e; ++i) hits[i] += 10;
+    });
+    for (int i = 0; i < 37; ++i) ASSERT_EQ(hits[i], i < 5 ? 11 : 1) << "round " << round << " item " << i;
+  }
+}
+
+}  // namespace segue
