@@ -100,16 +100,19 @@ double WalkerEnv::posture_terms(const float* a) const {
 WalkerWalk::WalkerWalk(const std::string& name, const WalkerConfig& config, double direction)
     : WalkerEnv(name, config), direction_(direction) {}
 
-StepResult WalkerWalk::evaluate(const float* action) {
+StepResult WalkerEnv::survival_step(double reward, bool ended) const {
   StepResult r;
-  double v = x_velocity();
-  r.reward = walk_reward(direction_ * v, action, 1.0, 1.0);
-  r.terminated = fallen();
-  r.info.success = !r.terminated && t_ >= cfg_.success_steps;
+  r.reward = reward;
+  r.terminated = ended;
+  r.info.success = !ended && t_ >= cfg_.success_steps;
   r.info.success_count = r.info.success ? 1 : 0;
-  r.info.metrics[0] = v;
+  r.info.metrics[0] = x_velocity();
   if (r.info.success) r.truncated = true;
   return r;
+}
+
+StepResult WalkerWalk::evaluate(const float* action) {
+  return survival_step(walk_reward(direction_ * x_velocity(), action, 1.0, 1.0), fallen());
 }
 
 }  // namespace segue

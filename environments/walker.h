@@ -65,6 +65,8 @@ class WalkerEnv : public MujocoEnv {
   // Forward-velocity, height and posture terms shared by walk-like rewards:
   //   speed_weight v' + upright + alive - height_weight |h* - dh| - foot - ctrl.
   double walk_reward(double v, const float* action, double speed_weight, double height_weight) const;
+  // The result of a step in a "survive success_steps steps" task.
+  StepResult survival_step(double reward, bool ended) const;
 
   double x_before_ = 0.0;
   int qx_, qz_, qpitch_;

@@ -177,31 +177,17 @@ void WalkerCrawl::reset_task() {
 }
 
 StepResult WalkerCrawl::evaluate(const float* action) {
-  StepResult r;
-  double v = x_velocity();
-  r.reward = walk_reward(v, action, 2.0, 0.0);  // no height term: crawling is low
+  double reward = walk_reward(x_velocity(), action, 2.0, 0.0);  // no height term: crawling is low
   bool contact = touching();
-  if (contact) r.reward -= ocfg_.contact_penalty;
-  r.terminated = fallen() || contact;
-  r.info.success = !r.terminated && t_ >= cfg_.success_steps;
-  r.info.success_count = r.info.success ? 1 : 0;
-  r.info.metrics[0] = v;
-  if (r.info.success) r.truncated = true;
-  return r;
+  if (contact) reward -= ocfg_.contact_penalty;
+  return survival_step(reward, fallen() || contact);
 }
 
 // ---- balance ---------------------------------------------------------------------------
 
 StepResult WalkerBalance::evaluate(const float* action) {
-  StepResult r;
-  double v = x_velocity();
-  r.reward = -std::abs(v) - 0.5 * std::abs(cfg_.height_target - delta_h()) + posture_terms(action);
-  r.terminated = fallen();
-  r.info.success = !r.terminated && t_ >= cfg_.success_steps;
-  r.info.success_count = r.info.success ? 1 : 0;
-  r.info.metrics[0] = v;
-  if (r.info.success) r.truncated = true;
-  return r;
+  double reward = -std::abs(x_velocity()) - 0.5 * std::abs(cfg_.height_target - delta_h()) + posture_terms(action);
+  return survival_step(reward, fallen());
 }
 
 }  // namespace segue

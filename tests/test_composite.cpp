@@ -3,18 +3,12 @@
 // meta-controller walks through the documented skill sequence.
 #include <gtest/gtest.h>
 
-#include "environments/registry.h"
+#include "tests/task_fixture.h"
 #include "environments/walker_course.h"
 #include "hrl/meta_controller.h"
 
 namespace segue {
 namespace {
-
-std::unique_ptr<Env> make(const std::string& task, const std::string& env = "{}") {
-  static std::vector<Recipe> keep;
-  keep.push_back(Recipe::parse("{env: " + env + "}", "test"));
-  return task_factory(task, keep.back().root().sub("env"))();
-}
 
 const float kZero[6] = {0, 0, 0, 0, 0, 0};
 
@@ -33,7 +27,7 @@ StepResult step_at(Env& env, double x, std::vector<float>& obs) {
 }  // namespace
 
 TEST(Hurdle, CountsEachCurbOnceAtOnePointFiveMetresPastItsEnd) {
-  auto env = make("hurdle", "{position_noise: 0, push_prob: 0}");
+  auto env = make_task("hurdle", "{position_noise: 0, push_prob: 0}");
   auto& course = dynamic_cast<WalkerCourse&>(*env);
   std::vector<float> obs(28);
   env->reset(0, obs.data());
@@ -60,7 +54,7 @@ TEST(Hurdle, CountsEachCurbOnceAtOnePointFiveMetresPastItsEnd) {
 }
 
 TEST(Hurdle, FeaturesAreDistancesToCurbs) {
-  auto env = make("hurdle", "{position_noise: 0, push_prob: 0}");
+  auto env = make_task("hurdle", "{position_noise: 0, push_prob: 0}");
   std::vector<float> obs(28);
   env->reset(0, obs.data());
   step_at(*env, 4.5, obs);
@@ -78,7 +72,7 @@ TEST(Hurdle, FeaturesAreDistancesToCurbs) {
 }
 
 TEST(ObstacleCourse, ThreeCurbsAndTwoCeilingsInASeededOrder) {
-  auto a = make("obstacle_course"), b = make("obstacle_course");
+  auto a = make_task("obstacle_course"), b = make_task("obstacle_course");
   std::vector<float> obs(28);
   std::vector<std::vector<int>> orders;
   for (uint64_t seed : {1, 2, 3, 4, 5, 6}) {
@@ -103,7 +97,7 @@ TEST(ObstacleCourse, ThreeCurbsAndTwoCeilingsInASeededOrder) {
 }
 
 TEST(Patrol, CountsATurnOncePerStoneAndFlipsDirection) {
-  auto env = make("patrol", "{push_prob: 0}");
+  auto env = make_task("patrol", "{push_prob: 0}");
   auto& patrol = dynamic_cast<WalkerPatrol&>(*env);
   std::vector<float> obs(27);
   // Find a seed that starts forward, for a readable script.
@@ -137,7 +131,7 @@ transitions:
   std::vector<Skill> skills(2);
   skills[0].name = "walk";
   skills[1].name = "jump";
-  auto env = make("hurdle", "{position_noise: 0, push_prob: 0}");
+  auto env = make_task("hurdle", "{position_noise: 0, push_prob: 0}");
   MetaController meta(recipe.root(), skills, env->spec().feature_names);
   std::vector<float> obs(28);
   env->reset(0, obs.data());

@@ -5,17 +5,11 @@
 #include <cmath>
 
 #include "core/rng.h"
-#include "environments/registry.h"
+#include "tests/task_fixture.h"
 #include "environments/walker_obstacles.h"
 
 namespace segue {
 namespace {
-
-std::unique_ptr<Env> make(const std::string& task, const std::string& env = "{}") {
-  static std::vector<Recipe> keep;
-  keep.push_back(Recipe::parse("{env: " + env + "}", "test"));
-  return task_factory(task, keep.back().root().sub("env"))();
-}
 
 // Moves the whole walker by dx along x (rootx) and recomputes positions.
 void shift_x(Env& env, double x, std::vector<float>& obs) {
@@ -29,17 +23,17 @@ const float kZero[6] = {0, 0, 0, 0, 0, 0};
 }  // namespace
 
 TEST(WalkerSubtasks, ShapesFollowTheSpec) {
-  EXPECT_EQ(make("walker_backward")->spec().obs_dim, 26);
-  EXPECT_EQ(make("walker_balance")->spec().obs_dim, 26);
-  EXPECT_EQ(make("walker_crawl")->spec().obs_dim, 26);
-  EXPECT_EQ(make("walker_jump")->spec().obs_dim, 28);
+  EXPECT_EQ(make_task("walker_backward")->spec().obs_dim, 26);
+  EXPECT_EQ(make_task("walker_balance")->spec().obs_dim, 26);
+  EXPECT_EQ(make_task("walker_crawl")->spec().obs_dim, 26);
+  EXPECT_EQ(make_task("walker_jump")->spec().obs_dim, 28);
   for (auto t : {"walker_backward", "walker_balance", "walker_crawl", "walker_jump"})
-    EXPECT_EQ(make(t)->spec().act_dim, 6) << t;
+    EXPECT_EQ(make_task(t)->spec().act_dim, 6) << t;
 }
 
 TEST(WalkerSubtasks, ResetIsDeterministicPerSeed) {
   for (auto t : {"walker_backward", "walker_balance", "walker_crawl", "walker_jump"}) {
-    auto a = make(t), b = make(t);
+    auto a = make_task(t), b = make_task(t);
     int d = a->spec().obs_dim;
     std::vector<float> oa(d), ob(d);
     a->reset(9, oa.data());
@@ -51,7 +45,7 @@ TEST(WalkerSubtasks, ResetIsDeterministicPerSeed) {
 }
 
 TEST(WalkerJump, ObstacleObservationByHand) {
-  auto env = make("walker_jump", "{curb_noise: 0, init_noise: 0, init_random_steps: 0, push_prob: 0}");
+  auto env = make_task("walker_jump", "{curb_noise: 0, init_noise: 0, init_random_steps: 0, push_prob: 0}");
   auto& jump = dynamic_cast<WalkerObstacleEnv&>(*env);
   std::vector<float> obs(28);
   env->reset(0, obs.data());
@@ -72,7 +66,7 @@ TEST(WalkerJump, ObstacleObservationByHand) {
 }
 
 TEST(WalkerJump, PassingTheCurbSucceedsAndTouchingItFails) {
-  auto env = make("walker_jump", "{curb_noise: 0, push_prob: 0}");
+  auto env = make_task("walker_jump", "{curb_noise: 0, push_prob: 0}");
   std::vector<float> obs(28);
   env->reset(1, obs.data());
   // Lift the walker and put it 1.5 m past the curb's end (7.2): success on the next step.
@@ -97,7 +91,7 @@ TEST(WalkerJump, PassingTheCurbSucceedsAndTouchingItFails) {
 }
 
 TEST(WalkerJump, EpisodeEndsPastX15) {
-  auto env = make("walker_jump", "{curb_noise: 0, push_prob: 0}");
+  auto env = make_task("walker_jump", "{curb_noise: 0, push_prob: 0}");
   std::vector<float> obs(28);
   env->reset(1, obs.data());
   shift_x(*env, 15.5, obs);
@@ -107,7 +101,7 @@ TEST(WalkerJump, EpisodeEndsPastX15) {
 }
 
 TEST(WalkerJump, SnapshotCarriesTheCurbPosition) {
-  auto a = make("walker_jump", "{push_prob: 0}"), b = make("walker_jump", "{push_prob: 0}");
+  auto a = make_task("walker_jump", "{push_prob: 0}"), b = make_task("walker_jump", "{push_prob: 0}");
   std::vector<float> oa(28), ob(28), act(6);
   a->reset(3, oa.data());
   b->reset(4, ob.data());  // a different curb position
@@ -127,7 +121,7 @@ TEST(WalkerJump, SnapshotCarriesTheCurbPosition) {
 }
 
 TEST(WalkerCrawl, StandingUnderTheCeilingTouchesIt) {
-  auto env = make("walker_crawl", "{push_prob: 0}");
+  auto env = make_task("walker_crawl", "{push_prob: 0}");
   std::vector<float> obs(26);
   env->reset(0, obs.data());
   StepResult r = env->step(kZero, obs.data());
@@ -146,7 +140,7 @@ TEST(WalkerCrawl, StandingUnderTheCeilingTouchesIt) {
 }
 
 TEST(WalkerBalance, RewardAtRestAndSuccessAfterSurviving) {
-  auto env = make("walker_balance", "{init_noise: 0, init_random_steps: 0, push_prob: 0, success_steps: 20, max_episode_steps: 20}");
+  auto env = make_task("walker_balance", "{init_noise: 0, init_random_steps: 0, push_prob: 0, success_steps: 20, max_episode_steps: 20}");
   std::vector<float> obs(26);
   env->reset(0, obs.data());
   auto& w = dynamic_cast<WalkerEnv&>(*env);
@@ -165,7 +159,7 @@ TEST(WalkerBalance, RewardAtRestAndSuccessAfterSurviving) {
 }
 
 TEST(WalkerBackward, RewardsMovingInMinusX) {
-  auto env = make("walker_backward", "{init_noise: 0, init_random_steps: 0, push_prob: 0}");
+  auto env = make_task("walker_backward", "{init_noise: 0, init_random_steps: 0, push_prob: 0}");
   std::vector<float> obs(26);
   env->reset(0, obs.data());
   auto& w = dynamic_cast<WalkerEnv&>(*env);

@@ -92,10 +92,7 @@ LoopRates loop_rates(const SkillRecipe& s, int threads, int iterations, int fram
 
 int bench_main(int argc, char** argv) {
   Args args(kBench, argc, argv);
-  if (args.help()) {
-    std::fputs(help_text(kBench).c_str(), stdout);
-    return 0;
-  }
+  if (args.help()) return print_help(kBench);
   std::string recipe_path = args.get("recipe", std::string(SEGUE_SOURCE_DIR) + "/experiments/primitives/walker_forward.yaml");
   const int iterations = args.get_int("iterations", 5), steps = args.get_int("steps", 100000);
   if (iterations <= 0 || steps <= 0) throw Error("segue bench: --iterations and --steps must be positive");

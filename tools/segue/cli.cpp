@@ -3,6 +3,7 @@
 #include <torch/torch.h>
 
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 #include "core/thread_pool.h"
@@ -78,6 +79,11 @@ std::string help_text(const Command& cmd) {
   }
   o << "  --help                show this help\n";
   return o.str();
+}
+
+int print_help(const Command& cmd) {
+  std::fputs(help_text(cmd).c_str(), stdout);
+  return 0;
 }
 
 void set_torch_threads(int threads) {

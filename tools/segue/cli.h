@@ -43,6 +43,8 @@ class Args {
 };
 
 std::string help_text(const Command& cmd);
+// Prints the command's help to stdout; returns exit code 0.
+int print_help(const Command& cmd);
 
 // Commands: each returns the process exit code.
 int train_main(int argc, char** argv);

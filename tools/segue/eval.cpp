@@ -33,10 +33,7 @@ const Command kEval{
 
 int eval_main(int argc, char** argv) {
   Args args(kEval, argc, argv);
-  if (args.help()) {
-    std::fputs(help_text(kEval).c_str(), stdout);
-    return 0;
-  }
+  if (args.help()) return print_help(kEval);
   if (!args.has("task")) throw Error("segue eval: --task NAME is required (see segue eval --help)");
   const std::string task = args.get("task", "");
   const int episodes = args.get_int("episodes", 50);

@@ -20,10 +20,7 @@ const Command kExport{
 
 int export_main(int argc, char** argv) {
   Args args(kExport, argc, argv);
-  if (args.help()) {
-    std::fputs(help_text(kExport).c_str(), stdout);
-    return 0;
-  }
+  if (args.help()) return print_help(kExport);
   Policy p = Policy::load(args.positional(0));
   p.export_torchscript(args.positional(1));
   std::printf("wrote %s (obs_dim %d, act_dim %d)\n", args.positional(1).c_str(), p.obs_dim(), p.act_dim());

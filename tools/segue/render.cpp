@@ -295,10 +295,7 @@ void on_mujoco_error(const char* msg) {
 
 int render_main(int argc, char** argv) {
   Args args(kRender, argc, argv);
-  if (args.help()) {
-    std::fputs(help_text(kRender).c_str(), stdout);
-    return 0;
-  }
+  if (args.help()) return print_help(kRender);
   const std::string source = args.positional(0);
   if (!args.has("out") && !args.has("frames"))
     throw Error("segue render: --out FILE.mp4 or --frames DIR is required (see segue render --help)");

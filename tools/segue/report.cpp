@@ -45,10 +45,7 @@ const char* row_name(const std::string& m) {
 
 int report_main(int argc, char** argv) {
   Args args(kReport, argc, argv);
-  if (args.help()) {
-    std::fputs(help_text(kReport).c_str(), stdout);
-    return 0;
-  }
+  if (args.help()) return print_help(kReport);
   const std::string task = args.positional(0);
   CompositeRecipe r = CompositeRecipe::load(args.get("recipe", CompositeRecipe::default_file(task)));
   const int threads = resolve_threads(args.get_int("threads", 0));

@@ -35,10 +35,7 @@ const Command kTrain{
 
 int train_main(int argc, char** argv) {
   Args args(kTrain, argc, argv);
-  if (args.help()) {
-    std::fputs(help_text(kTrain).c_str(), stdout);
-    return 0;
-  }
+  if (args.help()) return print_help(kTrain);
   const std::string recipe_path = args.positional(0);
   auto sets = args.all("set");
   if (args.has("threads")) sets.push_back("threads=" + args.get("threads", "0"));
