@@ -51,6 +51,7 @@ int report_main(int argc, char** argv) {
   const int threads = resolve_threads(args.get_int("threads", 0));
   set_torch_threads(1);
   std::vector<std::pair<std::string, ControllerFactory>> methods;
+  std::vector<std::pair<std::string, std::string>> skipped;  // method, why
   if (args.has("methods")) {
     for (const auto& m : split(args.get("methods", ""))) methods.push_back({m, method_controllers(r, m)});
   } else {
@@ -58,6 +59,7 @@ int report_main(int argc, char** argv) {
         methods.push_back({m, method_controllers(r, m)});
       } catch (const Error& e) {
         std::fprintf(stderr, "skipping %s: %s\n", m.c_str(), e.what());
+        skipped.push_back({m, e.what()});
       }
   }
   std::ostringstream json, md;
@@ -96,6 +98,7 @@ int report_main(int argc, char** argv) {
     md << "| " << row_name(name) << " | " << cell << " | " << list(seed_means) << " |\n";
     std::printf("%-16s %s\n", row_name(name), cell);
   }
+  for (const auto& [name, why] : skipped) md << "| " << row_name(name) << " | not measured | " << why << " |\n";
   json << "}\n";
   std::string out = args.get("out", std::string(SEGUE_SOURCE_DIR) + "/experiments/results");
   std::filesystem::create_directories(out);
