@@ -68,6 +68,7 @@ void MujocoEnv::reset(float* obs) {
 void MujocoEnv::simulate(const float* ctrl) {
   for (int i = 0; i < model_->nu; ++i) data_->ctrl[i] = ctrl[i];
   for (int k = 0; k < frame_skip_; ++k) mj_step(model_, data_);
+  physics_steps_ += frame_skip_;
 }
 
 StepResult MujocoEnv::step(const float* action, float* obs) {

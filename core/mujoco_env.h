@@ -32,6 +32,8 @@ class MujocoEnv : public Env {
   int frame_skip() const { return frame_skip_; }
   int episode_step() const { return t_; }
   double control_dt() const { return model_->opt.timestep * frame_skip_; }
+  // mj_step calls since construction, resets included (for throughput accounting).
+  int64_t physics_steps() const { return physics_steps_; }
   // Recomputes derived quantities (positions, contacts) after the state was edited by hand,
   // e.g. by a test that places the walker somewhere. Refreshes the observation.
   void forward(float* obs);
@@ -59,6 +61,7 @@ class MujocoEnv : public Env {
   Rng rng_;
   int frame_skip_;
   int t_ = 0;
+  int64_t physics_steps_ = 0;
   std::vector<float> clipped_;  // scratch for the clipped action
 };
 

@@ -10,6 +10,7 @@
 
 #include "algorithms/skill_recipe.h"
 #include "core/assets.h"
+#include "core/mujoco_env.h"
 #include "core/rng.h"
 #include "core/thread_pool.h"
 #include "tools/segue/cli.h"
@@ -22,7 +23,8 @@ const Command kBench{
     "[--json] [--recipe FILE] [--iterations K]",
     "Measures on the walker model, in physics steps per second: mujoco-testspeed, our raw\n"
     "physics loop, rollouts with policy inference, and the full PPO loop (rollout and\n"
-    "update), single-threaded and on every core, with the recipe's PPO settings.",
+    "update), single-threaded and on every core, with the recipe's PPO settings. Every\n"
+    "mj_step counts, episode resets included.",
     {},
     {{"json", "", "print one JSON object"},
      {"recipe", "FILE", "skill recipe whose settings to use (default experiments/primitives/walker_forward.yaml)"},
@@ -69,22 +71,30 @@ struct LoopRates {
   double rollout, ppo;
 };
 
-LoopRates loop_rates(const SkillRecipe& s, int threads, int iterations, int frame_skip) {
+// Every mj_step the environments ran, episode resets included.
+int64_t physics_steps(VectorEnv& envs) {
+  int64_t n = 0;
+  for (int i = 0; i < envs.size(); ++i) n += dynamic_cast<MujocoEnv&>(envs.env(i)).physics_steps();
+  return n;
+}
+
+LoopRates loop_rates(const SkillRecipe& s, int threads, int iterations) {
   set_torch_threads(1);  // as segue train: environments get the threads, LibTorch one
   VectorEnv envs(s.make_env, s.ppo.num_envs, threads);
   PPO ppo(s.ppo, s.net, envs, s.seed);
-  const double physics_per_rollout = double(s.ppo.rollout_size()) * frame_skip;
   IterationStats warm;
   ppo.collect_rollout(warm);  // first-touch allocations and caches
+  int64_t n0 = physics_steps(envs);
   auto t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < iterations; ++i) {
     IterationStats st;
     ppo.collect_rollout(st);
   }
-  double rollout = iterations * physics_per_rollout / seconds_since(t0);
+  double rollout = (physics_steps(envs) - n0) / seconds_since(t0);
+  n0 = physics_steps(envs);
   t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < iterations; ++i) ppo.iterate();
-  double full = iterations * physics_per_rollout / seconds_since(t0);
+  double full = (physics_steps(envs) - n0) / seconds_since(t0);
   return {rollout, full};
 }
 
@@ -100,14 +110,13 @@ int bench_main(int argc, char** argv) {
   SkillRecipe s = SkillRecipe::read(recipe, "runs/bench");
   recipe.reject_unknown();
   const std::string xml = asset_path("walker/walker.xml");
-  const int frame_skip = 4;  // walker: assets/walker/walker.xml with environments/walker.cpp
   const int cores = resolve_threads(0);
 
   double ts = testspeed(xml, steps);
   set_torch_threads(1);
   double ph = physics(xml, steps);
-  LoopRates one = loop_rates(s, 1, iterations, frame_skip);
-  LoopRates all = loop_rates(s, cores, iterations, frame_skip);
+  LoopRates one = loop_rates(s, 1, iterations);
+  LoopRates all = loop_rates(s, cores, iterations);
 
   if (args.has("json")) {
     std::printf("%s\n", json_object({{"testspeed_sps", ts},
