@@ -47,6 +47,21 @@ TEST(PpoLearning, ImprovesReturnOnAShortWalkerHorizon) {
   EXPECT_GT(after, before + 50.0) << "before " << before << " after " << after;
 }
 
+TEST(PpoLearning, TrainingDoesNotDependOnTheThreadCount) {
+  // `threads` only parallelises environment stepping, and LibTorch stays on one thread,
+  // so one and two stepping threads train bit-identical networks.
+  at::set_num_threads(1);
+  ShortWalker s;
+  VectorEnv e1(s.make, s.cfg.num_envs, 1), e2(s.make, s.cfg.num_envs, 2);
+  PPO a(s.cfg, s.spec, e1, 21), b(s.cfg, s.spec, e2, 21);
+  for (int i = 0; i < 3; ++i) {
+    IterationStats sa = a.iterate(), sb = b.iterate();
+    EXPECT_EQ(sa.policy_loss, sb.policy_loss) << "iteration " << i;
+  }
+  auto pa = a.net()->parameters(), pb = b.net()->parameters();
+  for (size_t i = 0; i < pa.size(); ++i) EXPECT_TRUE(torch::equal(pa[i], pb[i])) << "parameter " << i;
+}
+
 TEST(PpoLearning, CheckpointResumeRestoresEverythingButInFlightEpisodes) {
   at::set_num_threads(1);
   ShortWalker s;
