@@ -61,11 +61,23 @@ void MetricsCsv::write(const std::vector<double>& values) {
   out_.flush();
 }
 
+namespace {
+// The recipe without its top-level `threads:` line: the thread count does not change
+// what a run computes, so a run may resume with another one.
+std::string without_threads(const std::string& yaml) {
+  std::stringstream in(yaml);
+  std::string out;
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("threads:", 0) != 0) out += line + "\n";
+  return out;
+}
+}  // namespace
+
 RunDir::RunDir(const std::string& dir, const std::string& resolved) : dir_(dir) {
   fs::create_directories(dir);
   std::string recipe = file("recipe.yaml");
   if (fs::exists(recipe)) {
-    if (read_file(recipe) != resolved)
+    if (without_threads(read_file(recipe)) != without_threads(resolved))
       throw Error(recipe + ": this run directory was started with a different recipe; "
                   "choose another run_dir or remove the directory");
   } else {

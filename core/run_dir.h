@@ -26,7 +26,8 @@ class MetricsCsv {
 
 class RunDir {
  public:
-  // Opens or creates DIR. A DIR holding a different resolved recipe is refused.
+  // Opens or creates DIR. A DIR holding a different resolved recipe is refused (the
+  // `threads` setting aside: it does not change results).
   RunDir(const std::string& dir, const std::string& resolved_recipe);
   const std::string& path() const { return dir_; }
   std::string file(const std::string& name) const { return dir_ + "/" + name; }

@@ -1,0 +1,56 @@
+// Run directories: atomic writes, resume rules, metrics rows cut back to the checkpoint.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "core/error.h"
+#include "core/run_dir.h"
+
+namespace segue {
+
+class RunDirTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = std::filesystem::temp_directory_path() / ("segue_rundir_" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::filesystem::path dir_;
+};
+
+TEST_F(RunDirTest, AtomicWriteReplacesAndLeavesNoTemporary) {
+  std::filesystem::create_directories(dir_);
+  std::string path = (dir_ / "f.txt").string();
+  write_file_atomic(path, "one");
+  write_file_atomic(path, "two");
+  EXPECT_EQ(read_file(path), "two");
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
+}
+
+TEST_F(RunDirTest, ResumesWithAnotherThreadCountButNotAnotherRecipe) {
+  const std::string recipe = "task: walker_forward\nthreads: 0\nppo:\n  lr: 0.0003\n";
+  RunDir first(dir_.string(), recipe);
+  EXPECT_NO_THROW(RunDir(dir_.string(), "task: walker_forward\nthreads: 1\nppo:\n  lr: 0.0003\n"));
+  try {
+    RunDir(dir_.string(), "task: walker_forward\nthreads: 0\nppo:\n  lr: 0.001\n");
+    FAIL() << "a different learning rate was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("different recipe"), std::string::npos);
+  }
+}
+
+TEST_F(RunDirTest, MetricsKeepOnlyRowsUpToTheCheckpoint) {
+  std::filesystem::create_directories(dir_);
+  std::string path = (dir_ / "metrics.csv").string();
+  {
+    MetricsCsv csv(path, {"iteration", "x"}, 0);
+    for (int i = 1; i <= 5; ++i) csv.write({double(i), 10.0 * i});
+  }
+  {
+    MetricsCsv resumed(path, {"iteration", "x"}, 3);  // the checkpoint was at iteration 3
+    resumed.write({4, 41});
+  }
+  EXPECT_EQ(read_file(path), "iteration,x\n1,10\n2,20\n3,30\n4,41\n");
+}
+
+}  // namespace segue
