@@ -8,7 +8,7 @@ namespace segue {
 WalkerCourse::WalkerCourse(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o,
                            const Config& c)
     : WalkerObstacleEnv(name, w, o, true), ccfg_(c) {
-  spec_.feature_names = {"curb_ahead", "curb_behind", "ceiling_ahead", "ceiling_behind"};
+  spec_.feature_names = {"curb_ahead", "curb_behind", "ceiling_ahead", "ceiling_behind", "steps", "distance"};
   for (const auto& k : c.kinds) kinds_.push_back(k == "curb" ? ObstacleKind::Curb : ObstacleKind::Ceiling);
 }
 
@@ -23,6 +23,7 @@ void WalkerCourse::reset_task() {
   }
   set_obstacles(layout);
   WalkerEnv::reset_task();
+  start_x_ = torso_x();
 }
 
 bool WalkerCourse::near_ceiling() const {
@@ -36,6 +37,8 @@ bool WalkerCourse::near_ceiling() const {
 void WalkerCourse::features(double* out) const {
   double x = min_x();
   out[0] = out[1] = out[2] = out[3] = kFar;
+  out[4] = t_;
+  out[5] = std::abs(torso_x() - start_x_);
   // Next obstacle whose start is ahead, and the last whose end is behind.
   for (const auto& o : obstacles_)
     if (o.start > x) {
@@ -71,7 +74,7 @@ StepResult WalkerCourse::evaluate(const float* action) {
 WalkerPatrol::WalkerPatrol(const std::string& name, const WalkerConfig& w, const Config& c)
     : WalkerEnv(name, w, "walker/walker_patrol.xml"), pcfg_(c) {
   spec_.obs_dim = kBaseObsDim + 1;
-  spec_.feature_names = {"direction", "since_turn", "progress"};
+  spec_.feature_names = {"direction", "since_turn", "progress", "steps", "distance"};
 }
 
 void WalkerPatrol::reset_task() {
@@ -79,13 +82,15 @@ void WalkerPatrol::reset_task() {
   turns_ = 0;
   since_turn_ = 0;
   WalkerEnv::reset_task();
-  turn_x_ = torso_x();
+  turn_x_ = start_x_ = torso_x();
 }
 
 void WalkerPatrol::features(double* out) const {
   out[0] = direction_;
   out[1] = turns_ > 0 ? since_turn_ : 1e6;
   out[2] = direction_ * (torso_x() - turn_x_);
+  out[3] = t_;
+  out[4] = std::abs(torso_x() - start_x_);
 }
 
 StepResult WalkerPatrol::evaluate(const float* action) {
@@ -113,15 +118,16 @@ void WalkerPatrol::observe(float* obs) const {
 }
 
 void WalkerPatrol::save_task_state(std::vector<double>& out) const {
-  out.insert(out.end(), {double(direction_), double(turns_), double(since_turn_), turn_x_});
+  out.insert(out.end(), {double(direction_), double(turns_), double(since_turn_), turn_x_, start_x_});
 }
 
 void WalkerPatrol::restore_task_state(const double* in, size_t n) {
-  if (n < 4) throw Error(spec_.name + ": saved state lacks the patrol state");
+  if (n < 5) throw Error(spec_.name + ": saved state lacks the patrol state");
   direction_ = int(in[0]);
   turns_ = int(in[1]);
   since_turn_ = int(in[2]);
   turn_x_ = in[3];
+  start_x_ = in[4];
 }
 
 }  // namespace segue

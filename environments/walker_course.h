@@ -24,7 +24,8 @@ class WalkerCourse : public WalkerObstacleEnv {
 
   // Features: curb_ahead / ceiling_ahead (metres from x to the next obstacle's start when
   // it is of that kind, else "far"), curb_behind / ceiling_behind (metres past the end of
-  // the last obstacle behind x when of that kind, else far).
+  // the last obstacle behind x when of that kind, else far), steps (since the episode
+  // start) and distance (|torso x - its start x|).
   void features(double* out) const override;
   static constexpr double kFar = 1e6;
 
@@ -34,7 +35,10 @@ class WalkerCourse : public WalkerObstacleEnv {
 
  private:
   bool near_ceiling() const;
+  void save_extra(std::vector<double>& out) const override { out.push_back(start_x_); }
+  void restore_extra(const double* in, size_t n) override { start_x_ = n ? in[0] : 0.0; }
   Config ccfg_;
+  double start_x_ = 0.0;
   std::vector<ObstacleKind> kinds_;
 };
 
@@ -51,7 +55,8 @@ class WalkerPatrol : public WalkerEnv {
   WalkerPatrol(const std::string& name, const WalkerConfig& w, const Config& c);
 
   // Features: direction (+1 / -1), since_turn (control steps since the last turn, far
-  // before the first), progress (metres walked in the current direction since the turn).
+  // before the first), progress (metres walked in the current direction since the turn),
+  // steps (since the episode start), distance (|torso x - its start x|).
   void features(double* out) const override;
   int direction() const { return direction_; }
   int turns() const { return turns_; }
@@ -66,7 +71,7 @@ class WalkerPatrol : public WalkerEnv {
  private:
   Config pcfg_;
   int direction_ = 1, turns_ = 0, since_turn_ = 0;
-  double turn_x_ = 0.0;
+  double turn_x_ = 0.0, start_x_ = 0.0;
 };
 
 }  // namespace segue

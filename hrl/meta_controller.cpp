@@ -42,8 +42,11 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
   for (const Section& rule : root.items("start"))
     start_.push_back({find_skill(rule, "skill", skills), read_when(rule, features)});
   if (start_.empty()) throw root.error("start", "lists no start skill");
-  for (const Section& t : root.items("transitions"))
-    transitions_.push_back({find_skill(t, "from", skills), find_skill(t, "to", skills), read_when(t, features)});
+  for (const Section& t : root.items("transitions")) {
+    Transition tr{find_skill(t, "from", skills), find_skill(t, "to", skills), read_when(t, features), {}};
+    tr.expert_when = t.has("expert") ? read_when(t.sub("expert"), features) : tr.when;
+    transitions_.push_back(tr);
+  }
 }
 
 bool MetaController::holds(const std::vector<Condition>& when, const double* f) {

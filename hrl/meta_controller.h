@@ -27,6 +27,9 @@ struct Condition {
 struct Transition {
   int from, to;
   std::vector<Condition> when;
+  // Where pi_b's own demonstrations T_b are recorded: in episodes that pi_b runs from the
+  // start, while these hold (`expert: {when: ...}`; by default the interval itself).
+  std::vector<Condition> expert_when;
 };
 
 class MetaController {
@@ -39,9 +42,9 @@ class MetaController {
   // The index of the transition out of `skill` whose interval holds now, or -1.
   int active_transition(int skill, const double* features) const;
   const std::vector<Transition>& transitions() const { return transitions_; }
+  static bool holds(const std::vector<Condition>& when, const double* f);
 
  private:
-  static bool holds(const std::vector<Condition>& when, const double* f);
   std::vector<std::pair<int, std::vector<Condition>>> start_;
   std::vector<Transition> transitions_;
 };

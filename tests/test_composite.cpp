@@ -59,11 +59,13 @@ TEST(Hurdle, FeaturesAreDistancesToCurbs) {
   env->reset(0, obs.data());
   step_at(*env, 4.5, obs);
   auto& course = dynamic_cast<WalkerCourse&>(*env);
-  double x = course.min_x(), f[4];
+  double x = course.min_x(), f[6];
   env->features(f);
   EXPECT_NEAR(f[0], 8.0 - x, 1e-9);         // curb_ahead
   EXPECT_EQ(f[1], WalkerCourse::kFar);       // nothing behind yet
   EXPECT_EQ(f[2], WalkerCourse::kFar);       // no ceilings in Hurdle
+  EXPECT_EQ(f[4], 1);                        // steps since the start
+  EXPECT_NEAR(f[5], 4.5, 0.1);               // distance from the start (which is near x = 0)
   step_at(*env, 11.0, obs);
   x = course.min_x();
   env->features(f);
@@ -110,7 +112,7 @@ TEST(Patrol, CountsATurnOncePerStoneAndFlipsDirection) {
   r = step_at(*env, 2.2, obs);
   EXPECT_EQ(r.info.success_count, 1);
   EXPECT_EQ(patrol.direction(), -1);
-  double f[3];
+  double f[5];
   env->features(f);
   EXPECT_EQ(f[0], -1);
   EXPECT_EQ(f[1], 0);  // since_turn
@@ -135,7 +137,7 @@ transitions:
   MetaController meta(recipe.root(), skills, env->spec().feature_names);
   std::vector<float> obs(28);
   env->reset(0, obs.data());
-  double f[4];
+  double f[6];
   env->features(f);
   int skill = meta.start_skill(f);
   std::vector<std::pair<double, int>> switches;  // (x, new skill)

@@ -1,0 +1,154 @@
+#include "hrl/collection.h"
+
+#include <sstream>
+
+#include "core/rng.h"
+#include "core/run_dir.h"
+
+namespace segue {
+
+StartStates collect_start_states(const CompositeRecipe& r, int transition, int count, uint64_t seed,
+                                 int max_episodes) {
+  auto env = r.make_env();
+  const EnvSpec& spec = env->spec();
+  std::vector<Skill> skills = r.skills;
+  const auto& transitions = r.meta.transitions();
+  std::vector<float> obs(spec.obs_dim), act(spec.act_dim);
+  std::vector<double> f(spec.feature_names.size()), state;
+  StartStates out;
+  out.obs_dim = spec.obs_dim;
+  for (int e = 0; e < max_episodes && out.size() < count; ++e) {
+    env->reset(mix_seed(seed, e), obs.data());
+    env->features(f.data());
+    int skill = r.meta.start_skill(f.data());
+    for (bool done = false; !done && out.size() < count;) {
+      env->features(f.data());
+      int t = r.meta.active_transition(skill, f.data());
+      if (t >= 0) {
+        if (t == transition) {  // the interval a->b begins: pi_a's state here is in S_a
+          env->save_state(state);
+          out.state_dim = int(state.size());
+          out.states.insert(out.states.end(), state.begin(), state.end());
+          out.obs.insert(out.obs.end(), obs.begin(), obs.end());
+        }
+        skill = transitions[t].to;  // and go on as Without TP, to reach later intervals
+      }
+      const Skill& s = skills[skill];
+      s.policy.act(obs.data() + s.obs_begin, 1, act.data());
+      done = env->step(act.data(), obs.data()).done();
+    }
+  }
+  if (out.size() < count)
+    throw Error(r.file + ": transition " + std::to_string(transition) + " was entered only " +
+                std::to_string(out.size()) + " times in " + std::to_string(max_episodes) + " episodes");
+  return out;
+}
+
+Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, int count, uint64_t seed,
+                                      int max_episodes) {
+  auto env = r.make_env();
+  const EnvSpec& spec = env->spec();
+  const Transition& tr = r.meta.transitions().at(transition);
+  Skill b = r.skills[tr.to];
+  const int D = b.obs_end - b.obs_begin;
+  std::vector<float> obs(spec.obs_dim), act(spec.act_dim), prev(D);
+  std::vector<double> f(spec.feature_names.size());
+  Demonstrations out;
+  out.obs_dim = D;
+  out.act_dim = spec.act_dim;
+  for (int e = 0; e < max_episodes && out.size() < count; ++e) {
+    env->reset(mix_seed(seed, e), obs.data());
+    bool entered = false;
+    for (bool done = false; !done && out.size() < count;) {
+      env->features(f.data());
+      bool inside = MetaController::holds(tr.expert_when, f.data());
+      if (entered && !inside) break;  // past the window: this episode has nothing more
+      entered |= inside;
+      std::copy(obs.begin() + b.obs_begin, obs.begin() + b.obs_end, prev.begin());
+      b.policy.act(prev.data(), 1, act.data());
+      StepResult sr = env->step(act.data(), obs.data());
+      done = sr.done();
+      if (inside) {
+        out.obs.insert(out.obs.end(), prev.begin(), prev.end());
+        out.act.insert(out.act.end(), act.begin(), act.end());
+        out.next_obs.insert(out.next_obs.end(), obs.begin() + b.obs_begin, obs.begin() + b.obs_end);
+        out.done.push_back(sr.terminated);
+      }
+    }
+  }
+  if (out.size() < count)
+    throw Error(r.file + ": pi_b of transition " + std::to_string(transition) + " gave only " +
+                std::to_string(out.size()) + " demonstration steps in " + std::to_string(max_episodes) + " episodes");
+  return out;
+}
+
+namespace {
+
+template <class T>
+torch::Tensor as_tensor(const std::vector<T>& v, int64_t rows, torch::ScalarType type) {
+  auto t = torch::from_blob(const_cast<T*>(v.data()), {rows, rows ? int64_t(v.size()) / rows : 0}, type);
+  return t.clone();
+}
+template <class T>
+std::vector<T> as_vector(const torch::Tensor& t) {
+  auto c = t.contiguous();
+  return std::vector<T>(c.data_ptr<T>(), c.data_ptr<T>() + c.numel());
+}
+void write(torch::serialize::OutputArchive& ar, const std::string& path) {
+  std::ostringstream bytes;
+  ar.save_to(bytes);
+  write_file_atomic(path, bytes.str());
+}
+
+}  // namespace
+
+void save(const StartStates& s, const std::string& path) {
+  torch::serialize::OutputArchive ar;
+  ar.write("states", as_tensor(s.states, s.size(), torch::kFloat64));
+  ar.write("obs", as_tensor(s.obs, s.size(), torch::kFloat32));
+  write(ar, path);
+}
+
+void save(const Demonstrations& d, const std::string& path) {
+  const int64_t m = d.size();
+  torch::serialize::OutputArchive ar;
+  ar.write("obs", as_tensor(d.obs, m, torch::kFloat32));
+  ar.write("act", as_tensor(d.act, m, torch::kFloat32));
+  ar.write("next_obs", as_tensor(d.next_obs, m, torch::kFloat32));
+  ar.write("done", as_tensor(d.done, m, torch::kUInt8));
+  write(ar, path);
+}
+
+StartStates load_start_states(const std::string& path) {
+  torch::serialize::InputArchive ar;
+  ar.load_from(path);
+  torch::Tensor states, obs;
+  ar.read("states", states);
+  ar.read("obs", obs);
+  StartStates s;
+  s.state_dim = int(states.size(1));
+  s.obs_dim = int(obs.size(1));
+  s.states = as_vector<double>(states);
+  s.obs = as_vector<float>(obs);
+  return s;
+}
+
+Demonstrations load_demonstrations(const std::string& path) {
+  torch::serialize::InputArchive ar;
+  ar.load_from(path);
+  torch::Tensor obs, act, next, done;
+  ar.read("obs", obs);
+  ar.read("act", act);
+  ar.read("next_obs", next);
+  ar.read("done", done);
+  Demonstrations d;
+  d.obs_dim = int(obs.size(1));
+  d.act_dim = int(act.size(1));
+  d.obs = as_vector<float>(obs);
+  d.act = as_vector<float>(act);
+  d.next_obs = as_vector<float>(next);
+  d.done = as_vector<uint8_t>(done);
+  return d;
+}
+
+}  // namespace segue

@@ -1,0 +1,43 @@
+#pragma once
+// Algorithm 1, lines 3-4: the data a transition policy pi_ab is trained from.
+//   S_a: full simulator states of pi_a at the start of the transition interval, so a
+//        training episode can start exactly there. Collected in Without-TP episodes, at
+//        the step where the meta-controller enters the interval a->b.
+//   T_b: pi_b's own (s, a, s') inside its interval: episodes that pi_b runs from the start,
+//        recorded while the transition's `expert.when` holds. Observations are in pi_b's
+//        slice of the task observation.
+// Both are stored as tensors in a .pt file (torch.load-able) that later stages read back.
+#include <string>
+#include <vector>
+
+#include "hrl/composite_recipe.h"
+
+namespace segue {
+
+struct StartStates {
+  int state_dim = 0, obs_dim = 0;
+  std::vector<double> states;  // [N, state_dim], Env::save_state snapshots
+  std::vector<float> obs;      // [N, obs_dim], the task observation there
+  int size() const { return state_dim ? int(states.size() / state_dim) : 0; }
+};
+
+struct Demonstrations {
+  int obs_dim = 0, act_dim = 0;
+  std::vector<float> obs, act, next_obs;  // [M, obs_dim], [M, act_dim], [M, obs_dim]
+  std::vector<uint8_t> done;              // 1 where the episode truly ended
+  int size() const { return obs_dim ? int(obs.size() / obs_dim) : 0; }
+};
+
+// Runs seeded episodes (episode i from mix_seed(seed, i)) until `count` items are found;
+// throws segue::Error if `max_episodes` pass without enough.
+StartStates collect_start_states(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
+                                 int max_episodes = 100000);
+Demonstrations collect_demonstrations(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
+                                      int max_episodes = 100000);
+
+void save(const StartStates& s, const std::string& path);
+void save(const Demonstrations& d, const std::string& path);
+StartStates load_start_states(const std::string& path);
+Demonstrations load_demonstrations(const std::string& path);
+
+}  // namespace segue

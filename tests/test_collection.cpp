@@ -1,0 +1,94 @@
+// Algorithm 1's data: S_a states restore into an environment that then replays pi_a
+// exactly; T_b is pi_b's own contiguous trajectory inside its window; files round-trip.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "hrl/collection.h"
+
+namespace segue {
+namespace {
+
+// Patrol with the shipped walk and balance skills, pushes off so a replay needs no
+// random stream.
+CompositeRecipe patrol() {
+  return CompositeRecipe::load(CompositeRecipe::default_file("patrol"), {"env.push_prob=0"});
+}
+
+}  // namespace
+
+TEST(Collection, StartStatesAreAtTheIntervalAndReplayPiA) {
+  CompositeRecipe r = patrol();
+  StartStates s = collect_start_states(r, /*forward -> balance*/ 0, 4, 11);
+  ASSERT_EQ(s.size(), 4);
+  auto a = r.make_env(), b = r.make_env();
+  const Skill& pi_a = r.skills[r.meta.transitions()[0].from];
+  std::vector<float> oa(s.obs_dim), ob(s.obs_dim), act(6);
+  std::vector<double> f(a->spec().feature_names.size());
+  for (int i = 0; i < s.size(); ++i) {
+    std::vector<double> state(s.states.begin() + i * s.state_dim, s.states.begin() + (i + 1) * s.state_dim);
+    a->restore_state(state, oa.data());
+    ASSERT_EQ(oa, std::vector<float>(s.obs.begin() + i * s.obs_dim, s.obs.begin() + (i + 1) * s.obs_dim));
+    a->features(f.data());
+    EXPECT_TRUE(MetaController::holds(r.meta.transitions()[0].when, f.data())) << "state " << i;
+    // Two environments restored from the state run pi_a identically.
+    b->reset(999, ob.data());
+    b->restore_state(state, ob.data());
+    for (int t = 0; t < 50; ++t) {
+      pi_a.policy.act(oa.data() + pi_a.obs_begin, 1, act.data());
+      StepResult ra = a->step(act.data(), oa.data());
+      pi_a.policy.act(ob.data() + pi_a.obs_begin, 1, act.data());
+      StepResult rb = b->step(act.data(), ob.data());
+      ASSERT_EQ(oa, ob) << "state " << i << " step " << t;
+      if (ra.done() || rb.done()) break;
+    }
+  }
+}
+
+TEST(Collection, DemonstrationsArePiBsOwnStepsInItsWindow) {
+  CompositeRecipe r = patrol();
+  // forward -> balance: T_b is balance's first 100 steps from its own start.
+  Demonstrations d = collect_demonstrations(r, 0, 250, 3);
+  ASSERT_EQ(d.size(), 250);
+  EXPECT_EQ(d.obs_dim, 26);  // balance's slice of Patrol's 27 numbers
+  const Skill& balance = r.skills[r.meta.transitions()[0].to];
+  std::vector<float> a(6);
+  int episode_starts = 1;
+  for (int i = 0; i < d.size(); ++i) {
+    // The recorded action is pi_b's action for the recorded observation.
+    balance.policy.act(&d.obs[size_t(i) * 26], 1, a.data());
+    for (int j = 0; j < 6; ++j) ASSERT_EQ(a[j], d.act[size_t(i) * 6 + j]) << i;
+    if (i + 1 < d.size()) {
+      bool continues = std::equal(d.next_obs.begin() + i * 26, d.next_obs.begin() + (i + 1) * 26,
+                                  d.obs.begin() + (i + 1) * 26);
+      episode_starts += !continues;
+    }
+  }
+  // 101 steps per episode (steps 0..100) unless balance fell first: at least 3 episodes.
+  EXPECT_GE(episode_starts, 3);
+  EXPECT_LE(episode_starts, 250 / 20);
+
+  auto dir = std::filesystem::temp_directory_path() / ("segue_collect_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  save(d, (dir / "t_b.pt").string());
+  Demonstrations back = load_demonstrations((dir / "t_b.pt").string());
+  EXPECT_EQ(back.obs, d.obs);
+  EXPECT_EQ(back.act, d.act);
+  EXPECT_EQ(back.next_obs, d.next_obs);
+  EXPECT_EQ(back.done, d.done);
+  StartStates s = collect_start_states(r, 0, 2, 5);
+  save(s, (dir / "s_a.pt").string());
+  StartStates s2 = load_start_states((dir / "s_a.pt").string());
+  EXPECT_EQ(s2.states, s.states);
+  EXPECT_EQ(s2.obs, s.obs);
+  std::filesystem::remove_all(dir);
+}
+
+TEST(Collection, RefusesATransitionThatIsNeverEntered) {
+  // Balance -> forward needs a turn first; with a 10-step cap no episode gets there.
+  CompositeRecipe capped = CompositeRecipe::load(CompositeRecipe::default_file("patrol"),
+                                                 {"env.push_prob=0", "env.max_episode_steps=10"});
+  EXPECT_THROW(collect_start_states(capped, 2, 1, 0, 5), Error);
+}
+
+}  // namespace segue
