@@ -92,3 +92,38 @@ TEST(Collection, RefusesATransitionThatIsNeverEntered) {
 }
 
 }  // namespace segue
+
+#include "hrl/transition_env.h"
+
+namespace segue {
+
+TEST(TransitionEnv, EpisodesStartInSaAndEndWithTheInterval) {
+  CompositeRecipe r = CompositeRecipe::load(CompositeRecipe::default_file("patrol"), {"env.push_prob=0"});
+  const Transition& t = r.meta.transitions()[0];  // forward -> balance: since_turn in [0, 100]
+  StartStates s = collect_start_states(r, 0, 3, 1);
+  const Skill& b = r.skills[t.to];
+  TransitionEnv env(r.make_env(), s, t.when, b.obs_begin, b.obs_end);
+  EXPECT_EQ(env.spec().obs_dim, 26);
+  std::vector<float> obs(26), act(6);
+  std::vector<double> f(env.task().spec().feature_names.size());
+  for (int episode = 0; episode < 3; ++episode) {
+    env.reset(100 + episode, obs.data());
+    // The start is one of the S_a observations (its first 26 numbers).
+    bool found = false;
+    for (int i = 0; i < s.size(); ++i)
+      found |= std::equal(obs.begin(), obs.end(), s.obs.begin() + size_t(i) * s.obs_dim);
+    EXPECT_TRUE(found);
+    int steps = 0;
+    StepResult sr;
+    do {
+      b.policy.act(obs.data(), 1, act.data());
+      sr = env.step(act.data(), obs.data());
+      ++steps;
+    } while (!sr.done());
+    env.features(f.data());
+    if (sr.truncated) EXPECT_FALSE(MetaController::holds(t.when, f.data()));  // left the interval
+    EXPECT_LE(steps, 101);  // since_turn runs 0..100 from the start state
+  }
+}
+
+}  // namespace segue

@@ -1,0 +1,48 @@
+#include "hrl/transition_env.h"
+
+#include <algorithm>
+
+namespace segue {
+
+TransitionEnv::TransitionEnv(std::unique_ptr<Env> task, StartStates starts, std::vector<Condition> interval,
+                             int obs_begin, int obs_end)
+    : task_(std::move(task)), starts_(std::move(starts)), interval_(std::move(interval)), begin_(obs_begin),
+      end_(obs_end) {
+  if (starts_.size() == 0) throw Error("transition environment: S_a is empty");
+  spec_ = task_->spec();
+  spec_.name = task_->spec().name + " (transition)";
+  spec_.obs_dim = end_ - begin_;
+  full_.resize(task_->spec().obs_dim);
+  features_.resize(task_->spec().feature_names.size());
+  state_.resize(starts_.state_dim);
+}
+
+void TransitionEnv::slice(float* obs) const { std::copy(full_.begin() + begin_, full_.begin() + end_, obs); }
+
+void TransitionEnv::reset(uint64_t seed, float* obs) {
+  rng_.seed(seed);
+  reset(obs);
+}
+
+void TransitionEnv::reset(float* obs) {
+  int i = rng_.integer(0, starts_.size() - 1);
+  std::copy(starts_.states.begin() + size_t(i) * starts_.state_dim,
+            starts_.states.begin() + size_t(i + 1) * starts_.state_dim, state_.begin());
+  task_->restore_state(state_, full_.data());
+  slice(obs);
+}
+
+StepResult TransitionEnv::step(const float* action, float* obs) {
+  StepResult r = task_->step(action, full_.data());
+  slice(obs);
+  task_->features(features_.data());
+  if (!r.terminated && !MetaController::holds(interval_, features_.data())) r.truncated = true;
+  return r;
+}
+
+void TransitionEnv::restore_state(const std::vector<double>& state, float* obs) {
+  task_->restore_state(state, full_.data());
+  slice(obs);
+}
+
+}  // namespace segue

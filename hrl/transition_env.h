@@ -1,0 +1,40 @@
+#pragma once
+// The environment a transition policy pi_ab trains in (Algorithm 1, lines 8-9): each
+// episode starts from a state sampled from S_a and runs while the transition interval
+// holds. Leaving the interval ends the episode as a time limit (truncated: pi_b takes
+// over from there); the task ending (a fall) ends it for real. pi_ab sees pi_b's slice
+// of the task observation, the space its discriminator compares with T_b.
+#include <memory>
+
+#include "core/rng.h"
+#include "hrl/collection.h"
+#include "hrl/meta_controller.h"
+
+namespace segue {
+
+class TransitionEnv : public Env {
+ public:
+  TransitionEnv(std::unique_ptr<Env> task, StartStates starts, std::vector<Condition> interval,
+                int obs_begin, int obs_end);
+  const EnvSpec& spec() const override { return spec_; }
+  void reset(uint64_t seed, float* obs) override;
+  void reset(float* obs) override;
+  StepResult step(const float* action, float* obs) override;
+  void features(double* out) const override { task_->features(out); }
+  void save_state(std::vector<double>& out) const override { task_->save_state(out); }
+  void restore_state(const std::vector<double>& state, float* obs) override;
+  Env& task() { return *task_; }
+
+ private:
+  void slice(float* obs) const;
+  std::unique_ptr<Env> task_;
+  StartStates starts_;
+  std::vector<Condition> interval_;
+  int begin_, end_;
+  EnvSpec spec_;
+  Rng rng_;
+  std::vector<float> full_;
+  std::vector<double> features_, state_;
+};
+
+}  // namespace segue
