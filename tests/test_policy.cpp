@@ -9,6 +9,7 @@
 #include "algorithms/policy.h"
 #include "algorithms/ppo.h"
 #include "environments/registry.h"
+#include "tests/temp_dir.h"
 
 namespace segue {
 
@@ -30,15 +31,9 @@ TEST(EigenMlp, EqualsLibTorchForward) {
   }
 }
 
-class PolicyFiles : public ::testing::Test {
+class PolicyFiles : public TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() / ("segue_policy_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  std::filesystem::path dir_;
+  PolicyFiles() : TempDirTest("policy") {}
 };
 
 TEST_F(PolicyFiles, TorchScriptExportRoundTrip) {

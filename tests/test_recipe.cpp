@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "core/recipe.h"
+#include "tests/temp_dir.h"
 
 namespace segue {
 
@@ -71,15 +72,11 @@ CliRun run(const std::string& args) {
   return {WEXITSTATUS(status), out};
 }
 
-class CliErrors : public ::testing::Test {
+class CliErrors : public TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() / ("segue_cli_" + std::to_string(::getpid()));
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
+  CliErrors() : TempDirTest("cli") {}
   std::string write(const std::string& name, const std::string& text) {
-    auto p = (dir_ / name).string();
+    auto p = path(name);
     std::ofstream(p) << text;
     return p;
   }

@@ -5,22 +5,17 @@
 
 #include "core/error.h"
 #include "core/run_dir.h"
+#include "tests/temp_dir.h"
 
 namespace segue {
 
-class RunDirTest : public ::testing::Test {
+class RunDirTest : public TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() / ("segue_rundir_" + std::to_string(::getpid()));
-    std::filesystem::remove_all(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
-  std::filesystem::path dir_;
+  RunDirTest() : TempDirTest("rundir") {}
 };
 
 TEST_F(RunDirTest, AtomicWriteReplacesAndLeavesNoTemporary) {
-  std::filesystem::create_directories(dir_);
-  std::string path = (dir_ / "f.txt").string();
+  std::string path = this->path("f.txt");
   write_file_atomic(path, "one");
   write_file_atomic(path, "two");
   EXPECT_EQ(read_file(path), "two");
@@ -29,6 +24,7 @@ TEST_F(RunDirTest, AtomicWriteReplacesAndLeavesNoTemporary) {
 
 TEST_F(RunDirTest, ResumesWithAnotherThreadCountButNotAnotherRecipe) {
   const std::string recipe = "task: walker_forward\nthreads: 0\nppo:\n  lr: 0.0003\n";
+  std::filesystem::remove_all(dir_);  // RunDir creates it
   RunDir first(dir_.string(), recipe);
   EXPECT_NO_THROW(RunDir(dir_.string(), "task: walker_forward\nthreads: 1\nppo:\n  lr: 0.0003\n"));
   try {
@@ -40,8 +36,7 @@ TEST_F(RunDirTest, ResumesWithAnotherThreadCountButNotAnotherRecipe) {
 }
 
 TEST_F(RunDirTest, MetricsKeepOnlyRowsUpToTheCheckpoint) {
-  std::filesystem::create_directories(dir_);
-  std::string path = (dir_ / "metrics.csv").string();
+  std::string path = this->path("metrics.csv");
   {
     MetricsCsv csv(path, {"iteration", "x"}, 0);
     for (int i = 1; i <= 5; ++i) csv.write({double(i), 10.0 * i});
