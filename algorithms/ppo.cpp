@@ -107,16 +107,14 @@ void PPO::collect_rollout(IterationStats& stats) {
       obs_rms_.normalize(buf_.raw_obs_at(t) + size_t(i) * D, buf_.obs_at(t) + size_t(i) * D);
     sample_actions(t);
     envs_.step(buf_.actions_at(t));
+    std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf_.next_raw_obs_at(t));
     for (int i = 0; i < N; ++i) {
       size_t k = size_t(t) * N + i;
-      double r = envs_.reward()[i];
-      bool done = envs_.terminated()[i] || envs_.truncated()[i];
-      buf_.rewards[k] = static_cast<float>(r);
-      buf_.dones[k] = done;
-      running_return_[i] = running_return_[i] * cfg_.gamma + r;
-      ret_sample[0] = static_cast<float>(running_return_[i]);
-      return_rms_.update(ret_sample, 1);
-      if (done) running_return_[i] = 0.0;
+      if (envs_.terminated()[i] || envs_.truncated()[i])  // obs() already holds the next episode's start
+        std::copy(envs_.final_obs() + size_t(i) * D, envs_.final_obs() + size_t(i + 1) * D,
+                  buf_.next_raw_obs_at(t) + size_t(i) * D);
+      buf_.raw_rewards[k] = envs_.reward()[i];
+      buf_.dones[k] = envs_.terminated()[i] || envs_.truncated()[i];
       if (envs_.truncated()[i] && !envs_.terminated()[i]) {
         buf_.truncated_index.push_back(static_cast<int>(k));
         buf_.truncated_obs.resize(buf_.truncated_obs.size() + D);
@@ -136,6 +134,18 @@ void PPO::collect_rollout(IterationStats& stats) {
     stats.success_count = count / done.size();
   }
 
+  if (reward_hook_) reward_hook_(buf_);
+  // The scale of rewards: the std of the discounted return, tracked per environment.
+  for (int t = 0; t < T; ++t)
+    for (int i = 0; i < N; ++i) {
+      size_t k = size_t(t) * N + i;
+      double r = buf_.raw_rewards[k];
+      buf_.rewards[k] = static_cast<float>(r);
+      running_return_[i] = running_return_[i] * cfg_.gamma + r;
+      ret_sample[0] = static_cast<float>(running_return_[i]);
+      return_rms_.update(ret_sample, 1);
+      if (buf_.dones[k]) running_return_[i] = 0.0;
+    }
   if (cfg_.normalize_reward) {
     float scale = static_cast<float>(1.0 / std::sqrt(return_rms_.var()[0] + 1e-8));
     for (auto& r : buf_.rewards) r = std::clamp(r * scale, -10.0f, 10.0f);

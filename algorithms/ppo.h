@@ -4,6 +4,7 @@
 // and every piece of state it touches is a member you can see here.
 #include <torch/torch.h>
 
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -56,6 +57,14 @@ class PPO {
   void collect_rollout(IterationStats& stats);
   void update(IterationStats& stats);
 
+  // Replaces the environment's rewards after a rollout is collected and before they are
+  // scaled and turned into advantages: a transition policy's reward comes from its AIRL
+  // discriminator (Eq. 3), not from the task. The hook sees raw observations, actions,
+  // log pi_old and dones, and writes buf.rewards.
+  using RewardHook = std::function<void(RolloutBuffer& buf)>;
+  void set_reward_hook(RewardHook hook) { reward_hook_ = std::move(hook); }
+  const RolloutBuffer& buffer() const { return buf_; }
+
   // The deterministic policy (mean action, normaliser included).
   Policy policy() const;
   int64_t iteration() const { return iteration_; }
@@ -85,6 +94,7 @@ class PPO {
   uint64_t seed_;
   std::vector<double> running_return_;  // discounted return per env, for reward scaling
   std::vector<float> mean_, log_std_;
+  RewardHook reward_hook_;
   int64_t iteration_ = 0, global_step_ = 0;
   double wall_seconds_ = 0.0;
 };

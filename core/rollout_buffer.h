@@ -10,9 +10,11 @@ struct RolloutBuffer {
   int T = 0, N = 0, obs_dim = 0, act_dim = 0;
   std::vector<float> obs;       // normalised observations the policy saw  [T, N, obs_dim]
   std::vector<float> raw_obs;   // the same before normalisation (for the normaliser)
+  std::vector<float> next_raw_obs;  // s' before normalisation (the final one where an episode ended)
   std::vector<float> actions;   // sampled, unclipped                       [T, N, act_dim]
   std::vector<float> log_probs; // log pi_old(a|s)                          [T, N]
-  std::vector<float> rewards;   // [T, N]
+  std::vector<double> raw_rewards;  // as the task (or a reward hook) gives them  [T, N]
+  std::vector<float> rewards;   // scaled, with truncation bootstraps folded in  [T, N]
   std::vector<uint8_t> dones;   // episode ended at this step              [T, N]
   std::vector<float> values, advantages, returns;  // [T, N]
   // Truncated steps: their index t*N+n and the (normalised) final observation to bootstrap.
@@ -24,8 +26,10 @@ struct RolloutBuffer {
     size_t steps = size_t(t) * n;
     obs.resize(steps * od);
     raw_obs.resize(steps * od);
+    next_raw_obs.resize(steps * od);
     actions.resize(steps * ad);
     log_probs.resize(steps);
+    raw_rewards.resize(steps);
     rewards.resize(steps);
     dones.resize(steps);
     values.resize(steps);
@@ -36,6 +40,7 @@ struct RolloutBuffer {
   }
   float* obs_at(int t) { return &obs[size_t(t) * N * obs_dim]; }
   float* raw_obs_at(int t) { return &raw_obs[size_t(t) * N * obs_dim]; }
+  float* next_raw_obs_at(int t) { return &next_raw_obs[size_t(t) * N * obs_dim]; }
   float* actions_at(int t) { return &actions[size_t(t) * N * act_dim]; }
 };
 

@@ -62,6 +62,38 @@ TEST(PpoLearning, TrainingDoesNotDependOnTheThreadCount) {
   for (size_t i = 0; i < pa.size(); ++i) EXPECT_TRUE(torch::equal(pa[i], pb[i])) << "parameter " << i;
 }
 
+TEST(PpoLearning, RewardHookSeesNextObservationsAndReplacesRewards) {
+  at::set_num_threads(1);
+  ShortWalker s;
+  s.cfg.normalize_reward = false;
+  VectorEnv envs(s.make, s.cfg.num_envs, 1);
+  PPO ppo(s.cfg, s.spec, envs, 4);
+  int checked_next = 0, checked_falls = 0;
+  ppo.set_reward_hook([&](RolloutBuffer& b) {
+    const int D = b.obs_dim;
+    for (int t = 0; t < b.T; ++t)
+      for (int i = 0; i < b.N; ++i) {
+        size_t k = size_t(t) * b.N + i;
+        if (!b.dones[k] && t + 1 < b.T) {  // s' is the next row's s
+          ASSERT_TRUE(std::equal(&b.next_raw_obs[k * D], &b.next_raw_obs[(k + 1) * D], &b.raw_obs[(k + b.N) * D]));
+          ++checked_next;
+        } else if (b.dones[k] && b.next_raw_obs[k * D] < 0.8f) {
+          ++checked_falls;  // s' is the fallen state (torso height is observation 0), not a reset
+        }
+        b.raw_rewards[k] = 1.0;
+      }
+  });
+  IterationStats st;
+  ppo.collect_rollout(st);
+  EXPECT_GT(checked_next, 1000);
+  EXPECT_GT(checked_falls, 0);  // an untrained walker falls within 100 steps
+  const RolloutBuffer& b = ppo.buffer();
+  std::vector<uint8_t> bootstrapped(b.rewards.size(), 0);
+  for (int k : b.truncated_index) bootstrapped[k] = 1;
+  for (size_t k = 0; k < b.rewards.size(); ++k)
+    if (!bootstrapped[k]) ASSERT_EQ(b.rewards[k], 1.0f) << k;
+}
+
 TEST(PpoLearning, CheckpointResumeRestoresEverythingButInFlightEpisodes) {
   at::set_num_threads(1);
   ShortWalker s;
