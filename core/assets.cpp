@@ -19,4 +19,10 @@ std::string asset_path(const std::string& relative) {
   return path;
 }
 
+std::string repo_path(const std::string& path) {
+  if (std::filesystem::exists(path) || std::filesystem::path(path).is_absolute()) return path;
+  std::string in_tree = std::string(SEGUE_SOURCE_DIR) + "/" + path;
+  return std::filesystem::exists(in_tree) ? in_tree : path;
+}
+
 }  // namespace segue

@@ -2,6 +2,7 @@
 
 #include <filesystem>
 
+#include "core/assets.h"
 #include "environments/registry.h"
 
 namespace segue {
@@ -67,11 +68,6 @@ class WithoutTpController : public Controller {
   int skill_ = 0;
 };
 
-std::string resolve_policy(const std::string& path) {
-  if (std::filesystem::exists(path)) return path;
-  return std::string(SEGUE_SOURCE_DIR) + "/" + path;
-}
-
 }  // namespace
 
 ControllerFactory method_controllers(const CompositeRecipe& r, const std::string& method) {
@@ -79,7 +75,7 @@ ControllerFactory method_controllers(const CompositeRecipe& r, const std::string
     return [&r] { return std::make_unique<WithoutTpController>(r.skills, r.meta); };
   if (method == "single") {
     if (r.single_policy.empty()) throw Error(r.file + ": key 'methods.single.policy' is not set");
-    std::string path = resolve_policy(r.single_policy);
+    std::string path = repo_path(r.single_policy);
     if (!std::filesystem::exists(path))
       throw Error(r.file + ": key 'methods.single.policy': no such policy file '" + r.single_policy + "'");
     Policy p = Policy::load(path);

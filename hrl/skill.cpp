@@ -6,15 +6,6 @@
 
 namespace segue {
 
-namespace {
-// Relative policy paths are looked up from the working directory, then from the source tree.
-std::string resolve(const std::string& path) {
-  if (std::filesystem::exists(path) || std::filesystem::path(path).is_absolute()) return path;
-  std::string in_tree = std::string(SEGUE_SOURCE_DIR) + "/" + path;
-  return std::filesystem::exists(in_tree) ? in_tree : path;
-}
-}  // namespace
-
 std::vector<Skill> read_skills(const Section& section, const EnvSpec& task) {
   std::vector<Skill> skills;
   for (const auto& name : section.keys()) {
@@ -22,7 +13,7 @@ std::vector<Skill> read_skills(const Section& section, const EnvSpec& task) {
     Skill k;
     k.name = name;
     std::string file = s.require<std::string>("policy");
-    k.policy_path = resolve(file);
+    k.policy_path = repo_path(file);
     if (!std::filesystem::exists(k.policy_path))
       throw s.error("policy", "no such policy file '" + file + "'");
     try {
