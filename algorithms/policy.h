@@ -19,6 +19,9 @@ class Policy {
 
   int obs_dim() const { return mlp_.in_dim(); }
   int act_dim() const { return mlp_.out_dim(); }
+  const EigenMlp& mlp() const { return mlp_; }
+  const std::vector<float>& obs_mean() const { return obs_mean_; }
+  const std::vector<float>& obs_inv_std() const { return obs_inv_std_; }
   // obs: [batch, obs_dim] -> actions: [batch, act_dim]. Allocates only when the batch grows.
   void act(const float* obs, int batch, float* actions) const;
 

@@ -11,8 +11,7 @@
 
 namespace segue {
 
-PpoConfig PpoConfig::read(const Section& s) {
-  PpoConfig c;
+PpoConfig PpoConfig::read(const Section& s, PpoConfig c) {
   c.total_steps = s.get("total_steps", c.total_steps);
   c.num_envs = s.get("num_envs", c.num_envs);
   c.steps_per_env = s.get("steps_per_env", c.steps_per_env);
@@ -223,6 +222,40 @@ void PPO::update(IterationStats& stats) {
   refresh_inference_copy();
 }
 
+torch::Tensor PPO::log_prob(const float* raw_obs, const float* actions, int64_t n) {
+  const int D = buf_.obs_dim;
+  auto obs = torch::empty({n, D});
+  for (int64_t i = 0; i < n; ++i) obs_rms_.normalize(raw_obs + i * D, obs.data_ptr<float>() + i * D);
+  torch::NoGradGuard no_grad;
+  auto act = torch::from_blob(const_cast<float*>(actions), {n, int64_t(buf_.act_dim)});
+  return net_->log_prob(net_->mean(obs), act);
+}
+
+void PPO::init_actor(const Policy& p) {
+  if (p.obs_dim() != buf_.obs_dim || p.act_dim() != buf_.act_dim)
+    throw Error("init_actor: the policy's sizes differ from the trainer's");
+  const auto& ws = p.mlp().weights();
+  const auto& bs = p.mlp().biases();
+  torch::NoGradGuard no_grad;
+  size_t layer = 0;
+  for (auto& m : net_->actor->modules(/*include_self=*/false)) {
+    auto* linear = m->as<torch::nn::Linear>();
+    if (!linear) continue;
+    if (layer >= ws.size() || linear->weight.size(0) != ws[layer].rows() || linear->weight.size(1) != ws[layer].cols())
+      throw Error("init_actor: the policy's hidden layers differ from the trainer's");
+    linear->weight.copy_(torch::from_blob(const_cast<float*>(ws[layer].data()), {ws[layer].rows(), ws[layer].cols()}));
+    linear->bias.copy_(torch::from_blob(const_cast<float*>(bs[layer].data()), {bs[layer].cols()}));
+    ++layer;
+  }
+  if (layer != ws.size()) throw Error("init_actor: the policy's hidden layers differ from the trainer's");
+  std::vector<double> mean(p.obs_mean().begin(), p.obs_mean().end()), var(mean.size());
+  for (size_t j = 0; j < var.size(); ++j)
+    var[j] = std::max(1.0 / (double(p.obs_inv_std()[j]) * p.obs_inv_std()[j]) - obs_rms_.eps(), 0.0);
+  // Weighted as much data as pi_b's training saw, so the first rollouts barely move it.
+  obs_rms_.set(mean, var, 1e6);
+  refresh_inference_copy();
+}
+
 Policy PPO::policy() const {
   const auto& spec = envs_.spec();
   return Policy(actor_copy_, std::vector<float>(obs_rms_.mean().begin(), obs_rms_.mean().end()),
@@ -248,8 +281,9 @@ std::vector<int64_t> widen(const std::vector<int>& v) { return {v.begin(), v.end
 
 }  // namespace
 
-void PPO::save(const std::string& path, const std::string& note) const {
+void PPO::save(const std::string& path, const std::string& note, const ArchiveWriter& extra) const {
   torch::serialize::OutputArchive ar;
+  if (extra) extra(ar);
   for (const auto& p : net_->named_parameters()) ar.write(key(p.key()), p.value().detach());
   torch::serialize::OutputArchive opt;
   optimizer_->save(opt);
@@ -269,9 +303,10 @@ void PPO::save(const std::string& path, const std::string& note) const {
   write_file_atomic(path, bytes.str());
 }
 
-void PPO::load(const std::string& path) {
+void PPO::load(const std::string& path, const ArchiveReader& extra) {
   torch::serialize::InputArchive ar;
   ar.load_from(path);
+  if (extra) extra(ar);
   torch::Tensor dims;
   ar.read("meta_dims", dims);
   if (dims[0].item<int64_t>() != net_->spec.obs_dim || dims[1].item<int64_t>() != net_->spec.act_dim)

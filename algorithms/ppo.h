@@ -35,7 +35,8 @@ struct PpoConfig {
   bool normalize_reward = true;     // scale rewards by the std of the discounted return
   double obs_clip = 10.0;
 
-  static PpoConfig read(const Section& s);
+  static PpoConfig read(const Section& s, PpoConfig defaults);
+  static PpoConfig read(const Section& s) { return read(s, PpoConfig()); }
   int64_t rollout_size() const { return int64_t(num_envs) * steps_per_env; }
 };
 
@@ -73,10 +74,21 @@ class PPO {
   int64_t total_iterations() const;
   ActorCritic& net() { return net_; }
 
+  // log pi(a|s) of the current policy at raw (unnormalised) observations, no gradient:
+  // AIRL's D needs the generator's density at the expert's actions (Eq. 2).
+  torch::Tensor log_prob(const float* raw_obs, const float* actions, int64_t n);
+  // Starts the actor from a trained policy of the same sizes (weights and observation
+  // normaliser); the log std keeps its initial value. A transition policy can start as
+  // pi_b, whose behaviour it is trained to match.
+  void init_actor(const Policy& policy);
+
   // Checkpoint: network, optimiser, normalisers, counters and `note` (the resolved
-  // recipe), written atomically.
-  void save(const std::string& path, const std::string& note = "") const;
-  void load(const std::string& path);
+  // recipe), written atomically. `extra` adds an owner's state (a discriminator) to the
+  // same file, so the two can never be saved at different iterations.
+  using ArchiveWriter = std::function<void(torch::serialize::OutputArchive&)>;
+  using ArchiveReader = std::function<void(torch::serialize::InputArchive&)>;
+  void save(const std::string& path, const std::string& note = "", const ArchiveWriter& extra = {}) const;
+  void load(const std::string& path, const ArchiveReader& extra = {});
   static Policy policy_from_checkpoint(const std::string& path);
 
  private:

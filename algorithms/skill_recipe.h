@@ -9,7 +9,11 @@
 //   env: {...}                # the task's settings (reference defaults)
 //   policy: {pi_hidden: [32, 32], vf_hidden: [32, 32], activation: tanh, init_log_std: -0.5}
 //   ppo: {...}                # see PpoConfig
-//   eval: {episodes: 50, seed: 1000}
+//   eval: {episodes: 50, seed: 1000, reference_task: false}
+//
+// eval.reference_task: judge the trained skill on the task with every env key at its
+// reference value (a recipe may train on an easier or reshaped version, e.g. a curb
+// curriculum, and must still be measured on the spec's task).
 #include <functional>
 #include <memory>
 #include <string>
@@ -29,6 +33,7 @@ struct SkillRecipe {
   int eval_episodes = 50;
   uint64_t eval_seed = 1000;
   std::function<std::unique_ptr<Env>()> make_env;
+  std::function<std::unique_ptr<Env>()> eval_make_env;  // make_env, or the reference task
   ActorCriticSpec net;
   PpoConfig ppo;
 

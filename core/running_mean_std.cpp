@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/error.h"
+
 namespace segue {
 
 RunningMeanStd::RunningMeanStd(int dim, double clip, double eps)
@@ -35,6 +37,14 @@ void RunningMeanStd::update(const float* rows, int64_t n) {
     var_[j] = m2 / total;
   }
   count_ = total;
+  refresh();
+}
+
+void RunningMeanStd::set(const std::vector<double>& mean, const std::vector<double>& var, double count) {
+  if (mean.size() != mean_.size() || var.size() != var_.size()) throw Error("RunningMeanStd::set: wrong size");
+  mean_ = mean;
+  var_ = var;
+  count_ = count;
   refresh();
 }
 

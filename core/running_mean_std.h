@@ -14,6 +14,8 @@ class RunningMeanStd {
   // Adds a batch of `n` rows of length dim().
   void update(const float* rows, int64_t n);
   void normalize(const float* in, float* out) const;
+  // Replaces the statistics, as if `count` rows with this mean and variance had been seen.
+  void set(const std::vector<double>& mean, const std::vector<double>& var, double count);
   int dim() const { return static_cast<int>(mean_.size()); }
   double count() const { return count_; }
   const std::vector<double>& mean() const { return mean_; }

@@ -37,6 +37,10 @@ Factory walker_jump(const std::string& name, const Section& env) {
   j.cross_bonus = env.get("cross_bonus", j.cross_bonus);
   j.upward_weight = env.get("upward_weight", j.upward_weight);
   j.end_x = env.get("end_x", j.end_x);
+  j.curb_height = env.get("curb_height", j.curb_height);
+  j.curb_height_min = env.get("curb_height_min", j.curb_height);
+  if (j.curb_height_min > j.curb_height || j.curb_height_min <= 0)
+    throw env.error("curb_height_min", "must be in (0, curb_height]");
   return [=] { return std::make_unique<WalkerJump>(name, w, o, j); };
 }
 

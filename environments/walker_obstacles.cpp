@@ -59,6 +59,15 @@ void WalkerObstacleEnv::set_obstacles(const std::vector<Obstacle>& layout) {
   }
 }
 
+void WalkerObstacleEnv::set_curb_height(size_t index, double height) {
+  if (index >= curb_geoms_.size()) throw Error(spec_.name + ": no curb " + std::to_string(index));
+  int g = curb_geoms_[index];
+  model_->geom_size[3 * g + 2] = 0.5 * height;
+  model_->geom_pos[3 * g + 2] = 0.5 * height;
+  const double* s = &model_->geom_size[3 * g];
+  model_->geom_rbound[g] = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+}
+
 int WalkerObstacleEnv::next_obstacle() const {
   double x = min_x();
   for (size_t i = 0; i < obstacles_.size(); ++i)
@@ -136,6 +145,8 @@ WalkerJump::WalkerJump(const std::string& name, const WalkerConfig& w, const Obs
 void WalkerJump::reset_task() {
   double start = jcfg_.curb_x + rng_.symmetric(jcfg_.curb_noise);
   set_obstacles({{ObstacleKind::Curb, start, start + ocfg_.curb_width}});
+  height_ = rng_.uniform(jcfg_.curb_height_min, jcfg_.curb_height);
+  set_curb_height(0, height_);
   crossed_ = 0;
   WalkerEnv::reset_task();
 }
@@ -163,8 +174,15 @@ StepResult WalkerJump::evaluate(const float* action) {
   return r;
 }
 
-void WalkerJump::save_extra(std::vector<double>& out) const { out.push_back(crossed_); }
-void WalkerJump::restore_extra(const double* in, size_t n) { crossed_ = n ? int(in[0]) : 0; }
+void WalkerJump::save_extra(std::vector<double>& out) const {
+  out.push_back(crossed_);
+  out.push_back(height_);
+}
+void WalkerJump::restore_extra(const double* in, size_t n) {
+  crossed_ = n > 0 ? int(in[0]) : 0;
+  height_ = n > 1 ? in[1] : jcfg_.curb_height;
+  set_curb_height(0, height_);
+}
 
 // ---- crawl -----------------------------------------------------------------------------
 

@@ -48,6 +48,8 @@ class WalkerObstacleEnv : public WalkerEnv {
  protected:
   // Moves the model's obstacle geoms to this layout; unused ones are parked.
   void set_obstacles(const std::vector<Obstacle>& layout);
+  // Resizes the index-th curb of the layout to this height (it stands on the floor).
+  void set_curb_height(size_t index, double height);
   // Counts obstacles newly passed this step (in course order); returns how many.
   int update_passed();
   void observe(float* obs) const override;
@@ -76,6 +78,10 @@ class WalkerJump : public WalkerObstacleEnv {
     double cross_bonus = 10.0;  // once each for the trailing foot passing start, centre, end
     double upward_weight = 1.0; // + upward_weight max(vz, 0) while over the curb
     double end_x = 15.0;        // the episode ends past this x
+    // Curb height, drawn per episode from [curb_height_min, curb_height]. The task is
+    // the 0.4 m curb; a lower minimum is a curriculum that lets training find jumping
+    // by first stepping over low curbs (a policy only ever meeting 0.4 m runs into it).
+    double curb_height = 0.4, curb_height_min = 0.4;
   };
   WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
 
@@ -88,6 +94,7 @@ class WalkerJump : public WalkerObstacleEnv {
  private:
   Config jcfg_;
   int crossed_ = 0;  // how many of start, centre, end the trailing foot has crossed
+  double height_ = 0.4;
 };
 
 // Crawl: survive under a long ceiling (x from ceiling_start to ceiling_end).

@@ -8,39 +8,40 @@
 namespace segue {
 
 StartStates collect_start_states(const CompositeRecipe& r, int transition, int count, uint64_t seed,
-                                 int max_episodes) {
+                                 const std::vector<TransitionArtefacts>& trained, int max_episodes) {
   auto env = r.make_env();
   const EnvSpec& spec = env->spec();
-  std::vector<Skill> skills = r.skills;
-  const auto& transitions = r.meta.transitions();
+  const Transition& tr = r.meta.transitions().at(transition);
+  std::vector<TransitionArtefacts> artefacts = trained;
+  artefacts.resize(r.meta.transitions().size());
+  bool any_q = false;
+  for (const auto& a : artefacts) any_q |= bool(a.q);
+  TransitionController controller(r.skills, r.meta, artefacts, any_q ? SwitchRule::QNetwork : SwitchRule::IntervalEnd);
   std::vector<float> obs(spec.obs_dim), act(spec.act_dim);
   std::vector<double> f(spec.feature_names.size()), state;
   StartStates out;
   out.obs_dim = spec.obs_dim;
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {
     env->reset(mix_seed(seed, e), obs.data());
-    env->features(f.data());
-    int skill = r.meta.start_skill(f.data());
+    controller.reset(*env, obs.data());
     for (bool done = false; !done && out.size() < count;) {
       env->features(f.data());
-      int t = r.meta.active_transition(skill, f.data());
-      if (t >= 0) {
-        if (t == transition) {  // the interval a->b begins: pi_a's state here is in S_a
-          env->save_state(state);
-          out.state_dim = int(state.size());
-          out.states.insert(out.states.end(), state.begin(), state.end());
-          out.obs.insert(out.obs.end(), obs.begin(), obs.end());
-        }
-        skill = transitions[t].to;  // and go on as Without TP, to reach later intervals
+      // pi_a is running and the interval a->b begins: this state belongs to S_a.
+      if (controller.transition() < 0 && controller.skill() == tr.from &&
+          r.meta.active_transition(tr.from, f.data()) == transition) {
+        env->save_state(state);
+        out.state_dim = int(state.size());
+        out.states.insert(out.states.end(), state.begin(), state.end());
+        out.obs.insert(out.obs.end(), obs.begin(), obs.end());
       }
-      const Skill& s = skills[skill];
-      s.policy.act(obs.data() + s.obs_begin, 1, act.data());
+      controller.act(*env, obs.data(), act.data());
       done = env->step(act.data(), obs.data()).done();
     }
   }
   if (out.size() < count)
-    throw Error(r.file + ": transition " + std::to_string(transition) + " was entered only " +
-                std::to_string(out.size()) + " times in " + std::to_string(max_episodes) + " episodes");
+    throw Error(r.file + ": transition " + r.transition_name(transition) + " was entered only " +
+                std::to_string(out.size()) + " times in " + std::to_string(max_episodes) +
+                " episodes (collect.start_states asks for " + std::to_string(count) + ")");
   return out;
 }
 

@@ -1,8 +1,10 @@
 #pragma once
 // Algorithm 1, lines 3-4: the data a transition policy pi_ab is trained from.
 //   S_a: full simulator states of pi_a at the start of the transition interval, so a
-//        training episode can start exactly there. Collected in Without-TP episodes, at
-//        the step where the meta-controller enters the interval a->b.
+//        training episode can start exactly there. Collected at the step where the
+//        meta-controller enters the interval a->b, in episodes that join the skills with
+//        the transition policies trained so far (Without TP where there are none): a
+//        later interval is only reached as often as the earlier transitions succeed.
 //   T_b: pi_b's own (s, a, s') inside its interval: episodes that pi_b runs from the start,
 //        recorded while the transition's `expert.when` holds. Observations are in pi_b's
 //        slice of the task observation.
@@ -11,6 +13,7 @@
 #include <vector>
 
 #include "hrl/composite_recipe.h"
+#include "hrl/transition_controller.h"
 
 namespace segue {
 
@@ -30,8 +33,10 @@ struct Demonstrations {
 
 // Runs seeded episodes (episode i from mix_seed(seed, i)) until `count` items are found;
 // throws segue::Error if `max_episodes` pass without enough.
+// `trained`: per transition of the recipe, its pi_ab and q_ab where already trained (or
+// empty). Episodes use q_ab where there is one, else switch at the interval's end.
 StartStates collect_start_states(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
-                                 int max_episodes = 100000);
+                                 const std::vector<TransitionArtefacts>& trained = {}, int max_episodes = 20000);
 Demonstrations collect_demonstrations(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
                                       int max_episodes = 100000);
 

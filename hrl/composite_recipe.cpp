@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "core/assets.h"
+#include "hrl/transition_controller.h"
 #include "environments/registry.h"
 
 namespace segue {
@@ -28,11 +29,19 @@ CompositeRecipe CompositeRecipe::load(const std::string& file, const std::vector
   c.meta = MetaController(root, c.skills, c.spec.feature_names);
   Section methods = root.sub("methods");
   if (methods.has("single")) c.single_policy = methods.sub("single").require<std::string>("policy");
+  c.transitions_dir = methods.get<std::string>("transitions", "");
+  c.pipeline = PipelineConfig::read(root, c.task);
   Section ev = root.sub("eval");
   c.eval_episodes = ev.get("episodes", c.eval_episodes);
   c.eval_seeds = ev.get("seeds", c.eval_seeds);
   recipe.reject_unknown();
+  c.resolved = recipe.resolved_yaml();
   return c;
+}
+
+std::string CompositeRecipe::transition_name(int t) const {
+  const Transition& tr = meta.transitions().at(t);
+  return skills[tr.from].name + "-" + skills[tr.to].name;
 }
 
 const std::vector<std::string>& method_names() {
@@ -82,8 +91,41 @@ ControllerFactory method_controllers(const CompositeRecipe& r, const std::string
     p.check_fits(r.spec, path);
     return [p] { return std::make_unique<PolicyController>(p); };
   }
-  for (const auto& m : method_names())
-    if (m == method) throw Error("method '" + method + "' needs trained transition policies, which Segue cannot train yet");
+  if (method == "tp" || method == "tp+q" || method == "lee") {
+    if (r.transitions_dir.empty())
+      throw Error(r.file + ": key 'methods.transitions' is not set (a folder of trained transition policies)");
+    const std::string dir = repo_path(r.transitions_dir);
+    const std::string file = method == "lee" ? "lee.pt" : "policy.pt";
+    std::vector<TransitionArtefacts> artefacts(r.meta.transitions().size());
+    for (size_t t = 0; t < artefacts.size(); ++t) {
+      const Skill& b = r.skills[r.meta.transitions()[t].to];
+      std::string path = dir + "/" + r.transition_name(int(t)) + "/" + file;
+      if (!std::filesystem::exists(path))
+        throw Error(r.file + ": key 'methods.transitions': no " + file + " for transition " +
+                    r.transition_name(int(t)) + " in '" + r.transitions_dir + "' (train it with segue run)");
+      Policy p = Policy::load(path);
+      EnvSpec slice = r.spec;
+      slice.obs_dim = b.obs_end - b.obs_begin;
+      slice.act_dim = r.spec.act_dim + (method == "lee" ? 1 : 0);  // Lee's extra output: terminate
+      p.check_fits(slice, path);
+      artefacts[t].policy = p;
+      if (method == "tp+q") {
+        std::string q = dir + "/" + r.transition_name(int(t)) + "/q.pt";
+        if (!std::filesystem::exists(q))
+          throw Error(r.file + ": key 'methods.transitions': no q.pt for transition " + r.transition_name(int(t)) +
+                      " in '" + r.transitions_dir + "' (train it with segue run)");
+        Policy qp = Policy::load(q);
+        EnvSpec qs = r.spec;
+        qs.act_dim = 2;
+        qp.check_fits(qs, q);
+        artefacts[t].q = qp;
+      }
+    }
+    SwitchRule rule = method == "tp" ? SwitchRule::IntervalEnd
+                      : method == "tp+q" ? SwitchRule::QNetwork
+                                         : SwitchRule::TerminationHead;
+    return [&r, artefacts, rule] { return std::make_unique<TransitionController>(r.skills, r.meta, artefacts, rule); };
+  }
   std::string known;
   for (const auto& m : method_names()) known += (known.empty() ? "" : ", ") + m;
   throw Error("unknown method '" + method + "' (methods: " + known + ")");

@@ -14,13 +14,16 @@
 //     - {from: jump, to: walk, when: {curb_behind: [2.5, 3.5]}}
 //   methods:
 //     single: {policy: assets/policies/walker/single/hurdle.pt}
+//     transitions: assets/policies/walker/hurdle   # NAME/policy.pt, q.pt per transition
 //   eval: {episodes: 50, seeds: [0, 1, 2]}
+//   ... and the pipeline's settings (hrl/pipeline_config.h).
 #include <string>
 #include <vector>
 
 #include "core/recipe.h"
 #include "hrl/evaluation.h"
 #include "hrl/meta_controller.h"
+#include "hrl/pipeline_config.h"
 #include "hrl/skill.h"
 
 namespace segue {
@@ -31,7 +34,10 @@ struct CompositeRecipe {
   EnvSpec spec;
   std::vector<Skill> skills;
   MetaController meta;
-  std::string single_policy;  // methods.single.policy ("" when absent)
+  std::string single_policy;    // methods.single.policy ("" when absent)
+  std::string transitions_dir;  // methods.transitions ("" when absent)
+  PipelineConfig pipeline;
+  std::string resolved;         // the recipe as read, defaults included (for run dirs)
   int eval_episodes = 50;
   std::vector<int> eval_seeds{0, 1, 2};
 
@@ -40,6 +46,8 @@ struct CompositeRecipe {
   static CompositeRecipe load(const std::string& file, const std::vector<std::string>& overrides = {});
   // The recipe for a task name: experiments/<task>.yaml in the source tree.
   static std::string default_file(const std::string& task);
+  // "from-to", e.g. "walk-jump": the transition's folder name among the artefacts.
+  std::string transition_name(int t) const;
 };
 
 // Method names from the paper: single, without-tp, tp, lee, tp+q.

@@ -37,6 +37,9 @@ StepResult TransitionEnv::step(const float* action, float* obs) {
   slice(obs);
   task_->features(features_.data());
   if (!r.terminated && !MetaController::holds(interval_, features_.data())) r.truncated = true;
+  // A transition episode succeeds when it reaches the interval's end on its feet.
+  r.info.success = r.truncated && !r.terminated;
+  r.info.success_count = r.info.success;
   return r;
 }
 

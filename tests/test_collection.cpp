@@ -88,7 +88,7 @@ TEST(Collection, RefusesATransitionThatIsNeverEntered) {
   // Balance -> forward needs a turn first; with a 10-step cap no episode gets there.
   CompositeRecipe capped = CompositeRecipe::load(CompositeRecipe::default_file("patrol"),
                                                  {"env.push_prob=0", "env.max_episode_steps=10"});
-  EXPECT_THROW(collect_start_states(capped, 2, 1, 0, 5), Error);
+  EXPECT_THROW(collect_start_states(capped, 2, 1, 0, {}, 5), Error);
 }
 
 }  // namespace segue

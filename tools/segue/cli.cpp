@@ -1,5 +1,7 @@
 #include "tools/segue/cli.h"
 
+#include <csignal>
+
 #include <torch/torch.h>
 
 #include <cmath>
@@ -84,6 +86,25 @@ std::string help_text(const Command& cmd) {
 int print_help(const Command& cmd) {
   std::fputs(help_text(cmd).c_str(), stdout);
   return 0;
+}
+
+namespace {
+std::atomic<int> g_stop{0};
+extern "C" void segue_on_stop_signal(int sig) {
+  g_stop = sig;
+  std::signal(sig, SIG_DFL);  // a second signal stops at once
+}
+}  // namespace
+
+const std::atomic<int>& install_stop_signals() {
+  std::signal(SIGINT, segue_on_stop_signal);
+  std::signal(SIGTERM, segue_on_stop_signal);
+  return g_stop;
+}
+
+void uninstall_stop_signals() {
+  std::signal(SIGINT, SIG_DFL);
+  std::signal(SIGTERM, SIG_DFL);
 }
 
 void set_torch_threads(int threads) {

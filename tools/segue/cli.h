@@ -1,6 +1,7 @@
 #pragma once
 // Command-line plumbing shared by the segue commands: flag parsing with per-command
 // help, and the one-line error convention.
+#include <atomic>
 #include <map>
 #include <string>
 #include <vector>
@@ -48,11 +49,18 @@ int print_help(const Command& cmd);
 
 // Commands: each returns the process exit code.
 int train_main(int argc, char** argv);
+int run_main(int argc, char** argv);
 int eval_main(int argc, char** argv);
 int export_main(int argc, char** argv);
 int bench_main(int argc, char** argv);
 int report_main(int argc, char** argv);
 int render_main(int argc, char** argv);
+
+// Ctrl-C and SIGTERM set the returned flag (the signal number), which a long command polls
+// to checkpoint and stop; a second signal stops at once. uninstall_stop_signals() restores
+// the default handlers.
+const std::atomic<int>& install_stop_signals();
+void uninstall_stop_signals();
 
 // Sets LibTorch's intra-op threads; 0 means every core.
 void set_torch_threads(int threads);

@@ -15,6 +15,8 @@ const char* kUsage =
     "Segue composes pretrained skills with transition policies (Byun & Perrault, ICLR 2022).\n\n"
     "commands:\n"
     "  train RECIPE       train a skill with PPO from a YAML recipe (resumes an interrupted run)\n"
+    "  run RECIPE         the whole method on a composite task: collect, transition policies,\n"
+    "                     switch Q-networks, evaluation (resumes an interrupted run)\n"
     "  eval [POLICY]      evaluate a policy on a task, or a method on a composite task\n"
     "  report TASK        evaluate methods over seeds; write experiments/results/TASK.{md,json}\n"
     "  export CKPT OUT    write a checkpoint's policy as TorchScript\n"
@@ -33,6 +35,7 @@ int main(int argc, char** argv) {
   std::string cmd = argv[1];
   try {
     if (cmd == "train") return segue::cli::train_main(argc - 2, argv + 2);
+    if (cmd == "run") return segue::cli::run_main(argc - 2, argv + 2);
     if (cmd == "eval") return segue::cli::eval_main(argc - 2, argv + 2);
     if (cmd == "export") return segue::cli::export_main(argc - 2, argv + 2);
     if (cmd == "render") return segue::cli::render_main(argc - 2, argv + 2);

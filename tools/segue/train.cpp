@@ -1,6 +1,5 @@
 // segue train RECIPE: PPO on one task, with a run directory that survives interruption.
 #include <atomic>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 
@@ -15,11 +14,6 @@
 namespace segue::cli {
 namespace {
 
-std::atomic<int> g_stop{0};
-extern "C" void on_signal(int sig) {
-  g_stop = sig;
-  std::signal(sig, SIG_DFL);  // a second signal stops at once
-}
 
 const Command kTrain{
     "train",
@@ -64,8 +58,7 @@ int train_main(int argc, char** argv) {
                   "approx_kl", "clip_fraction", "rollout_seconds", "update_seconds", "wall_seconds"},
                  ppo.iteration());
 
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  const std::atomic<int>& stop = install_stop_signals();
   Progress progress(s.task, s.ppo.total_steps, ppo.global_step());
   double recent_return = NAN, recent_success = NAN;
   while (ppo.global_step() < s.ppo.total_steps) {
@@ -76,23 +69,22 @@ int train_main(int argc, char** argv) {
                st.entropy, st.approx_kl, st.clip_fraction, st.rollout_seconds, st.update_seconds,
                ppo.wall_seconds()});
     bool last = ppo.global_step() >= s.ppo.total_steps;
-    if (last || g_stop || st.iteration % s.checkpoint_every == 0)
+    if (last || stop || st.iteration % s.checkpoint_every == 0)
       ppo.save(dir.checkpoint(), recipe.resolved_yaml());
     progress.update(ppo.global_step(), recent_return, recent_success);
-    if (g_stop && !last) {
+    if (stop && !last) {
       progress.finish();
       spdlog::warn("interrupted: checkpoint saved at iteration {}; rerun the same command to resume",
                    ppo.iteration());
-      return 128 + g_stop;
+      return 128 + stop;
     }
   }
   progress.finish();
-  std::signal(SIGINT, SIG_DFL);
-  std::signal(SIGTERM, SIG_DFL);
+  uninstall_stop_signals();
 
   Policy policy = ppo.policy();
   policy.export_torchscript(dir.file("policy.pt"));
-  EvalResult ev = evaluate_policy(policy, s.make_env, s.eval_episodes, s.eval_seed, threads);
+  EvalResult ev = evaluate_policy(policy, s.eval_make_env, s.eval_episodes, s.eval_seed, threads);
   Summary ret = summarize(ev.returns), count = summarize(ev.success_counts);
   double success = summarize(std::vector<double>(ev.successes.begin(), ev.successes.end())).mean;
   std::vector<std::pair<std::string, double>> fields{

@@ -1,0 +1,29 @@
+#pragma once
+// `segue run RECIPE`: Algorithms 1 and 2 for every transition of a composite task, then
+// the results table. Per transition NAME ("walk-jump"), in the run directory:
+//   1. collect     NAME/start_states.pt (S_a), NAME/demonstrations.pt (T_b)
+//   2. transition  NAME/policy.pt (pi_ab, TorchScript), NAME/transition.csv; training
+//                  checkpoints to NAME/transition_checkpoint.pt and resumes from it
+//   3. switch      NAME/q.pt (q_ab, TorchScript), NAME/switch.csv
+// and finally
+//   4. evaluate    TASK.md / TASK.json: every method whose artefacts exist
+// A stage whose outputs exist is skipped, so rerunning an interrupted run resumes it.
+#include <atomic>
+#include <string>
+#include <vector>
+
+#include "hrl/composite_recipe.h"
+
+namespace segue {
+
+struct PipelineOptions {
+  int threads = 1;                     // environment stepping
+  const std::atomic<int>* stop = nullptr;  // set by a signal: checkpoint and return
+  std::string publish_dir;             // also write the table here ("" = only the run dir)
+  std::string command;                 // how the run was started, for the table
+};
+
+// Returns 0 when every stage is done, or the signal number when stopped early.
+int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& options);
+
+}  // namespace segue

@@ -1,0 +1,77 @@
+#include "hrl/pipeline_config.h"
+
+namespace segue {
+
+CollectConfig CollectConfig::read(const Section& s) {
+  CollectConfig c;
+  c.start_states = s.get("start_states", c.start_states);
+  c.demonstrations = s.get("demonstrations", c.demonstrations);
+  if (c.start_states <= 0) throw s.error("start_states", "must be positive");
+  if (c.demonstrations <= 0) throw s.error("demonstrations", "must be positive");
+  return c;
+}
+
+TransitionPolicyConfig TransitionPolicyConfig::read(const Section& s) {
+  TransitionPolicyConfig c;
+  c.ppo.lr = 1e-4;  // policy Adam 1e-4 (spec)
+  c.ppo.total_steps = 1'000'000;
+  c.ppo.steps_per_env = 256;
+  c.ppo.minibatch_size = 512;
+  c.ppo = PpoConfig::read(s.sub("ppo"), c.ppo);
+  Section pol = s.sub("policy");
+  c.net.pi_hidden = pol.get("pi_hidden", c.net.pi_hidden);
+  c.net.vf_hidden = pol.get("vf_hidden", std::vector<int>{64, 64});
+  c.net.init_log_std = pol.get("init_log_std", -1.0);
+  c.init_from_next = s.get("init_from_next", c.init_from_next);
+  c.reward = s.get("reward", c.reward);
+  if (c.reward != "airl" && c.reward != "airl_absorbing" && c.reward != "airl_nonnegative")
+    throw s.error("reward", "must be airl (Eq. 3), airl_absorbing or airl_nonnegative (-log(1 - D))");
+  Section d = s.sub("discriminator");
+  c.discriminator.hidden = d.get("hidden", c.discriminator.hidden);
+  c.disc_lr = d.get("lr", c.disc_lr);
+  c.disc_batch = d.get("batch", c.disc_batch);
+  c.disc_steps = d.get("steps", c.disc_steps);
+  if (c.disc_batch <= 0) throw d.error("batch", "must be positive");
+  if (c.disc_steps < 0) throw d.error("steps", "must be >= 0");
+  if (!(c.disc_lr > 0)) throw d.error("lr", "must be positive");
+  return c;
+}
+
+SwitchConfig SwitchConfig::read(const Section& s) {
+  SwitchConfig c;
+  c.net.hidden = s.get("hidden", c.net.hidden);
+  c.net.gamma = s.get("gamma", c.net.gamma);
+  c.lr = s.get("lr", c.lr);
+  c.batch = s.get("batch", c.batch);
+  c.replay = s.get("replay", c.replay);
+  c.target_every = s.get("target_every", c.target_every);
+  c.r_success = s.get("r_success", c.r_success);
+  c.r_fail = s.get("r_fail", c.r_fail);
+  c.attempts = s.get("attempts", c.attempts);
+  c.updates_per_attempt = s.get("updates_per_attempt", c.updates_per_attempt);
+  c.warmup = s.get("warmup", c.warmup);
+  c.epsilon_start = s.get("epsilon_start", c.epsilon_start);
+  c.epsilon_end = s.get("epsilon_end", c.epsilon_end);
+  c.explore_fraction = s.get("explore_fraction", c.explore_fraction);
+  c.max_subtask_steps = s.get("max_subtask_steps", c.max_subtask_steps);
+  if (c.batch <= 0) throw s.error("batch", "must be positive");
+  if (c.replay < c.batch) throw s.error("replay", "must hold at least one batch");
+  if (c.target_every <= 0) throw s.error("target_every", "must be positive");
+  if (c.attempts < 0) throw s.error("attempts", "must be >= 0");
+  if (!(c.lr > 0)) throw s.error("lr", "must be positive");
+  if (!(c.explore_fraction > 0)) throw s.error("explore_fraction", "must be positive");
+  return c;
+}
+
+PipelineConfig PipelineConfig::read(const Section& root, const std::string& task) {
+  PipelineConfig c;
+  c.run_dir = root.get("run_dir", "runs/" + task);
+  c.seed = root.get<uint64_t>("seed", c.seed);
+  c.threads = root.get("threads", c.threads);
+  c.collect = CollectConfig::read(root.sub("collect"));
+  c.transition = TransitionPolicyConfig::read(root.sub("transition"));
+  c.switching = SwitchConfig::read(root.sub("switch"));
+  return c;
+}
+
+}  // namespace segue

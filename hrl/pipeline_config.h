@@ -1,0 +1,79 @@
+#pragma once
+// The settings of `segue run`'s stages, read from a composite recipe (every key has a
+// default: the spec's where it gives one):
+//
+//   run_dir: runs/hurdle
+//   seed: 1
+//   threads: 0
+//   collect: {start_states: 1000, demonstrations: 100000}     # |S_a|, |T_b| per transition
+//   transition: {ppo: {...}, policy: {...}, init_from_next: true, discriminator: {...}}
+//   switch: {attempts: 2000, lr: 1.0e-4, ...}
+#include <string>
+#include <vector>
+
+#include "algorithms/discriminator.h"
+#include "algorithms/ppo.h"
+#include "algorithms/switch_q_network.h"
+#include "core/recipe.h"
+
+namespace segue {
+
+struct CollectConfig {
+  int start_states = 1000;      // S_a per transition (reference 10,000)
+  int demonstrations = 100000;  // T_b rows per transition (reference 1,000,000)
+  static CollectConfig read(const Section& s);
+};
+
+struct TransitionPolicyConfig {
+  PpoConfig ppo;                 // the generator's PPO
+  ActorCriticSpec net;           // 2 x 32 tanh, as the skills (spec)
+  bool init_from_next = true;    // start pi_ab as a copy of pi_b (false: random, as the paper)
+  // The generator's reward from D.
+  //   "airl": Eq. 3, log D - log(1 - D) = f - log pi.
+  //   "airl_absorbing": Eq. 3, and a fall leads to an absorbing state that keeps paying
+  //       the rollout's worst Eq. 3 reward for ever: gamma min(r) / (1 - gamma) at the fall.
+  //   "airl_nonnegative": -log(1 - D) = softplus(Eq. 3).
+  // Eq. 3 is negative wherever D is confident, so a generator whose episodes can end by
+  // falling is paid to fall early (the survival bias of adversarial imitation; Kostrikov
+  // et al. 2019 fix it with absorbing states). Transition episodes start far from pi_b's
+  // states and fall often, so this matters here. softplus removes the bias but flattens
+  // the reward to ~0 once D is confident, which it is at first.
+  std::string reward = "airl_absorbing";
+  DiscriminatorSpec discriminator;
+  double disc_lr = 3e-4;         // Adam (spec)
+  int disc_batch = 256;          // expert and generator rows per discriminator step, each
+  int disc_steps = 16;           // discriminator steps per PPO iteration
+
+  // Reads the recipe's `transition:` section (every key has a default).
+  static TransitionPolicyConfig read(const Section& s);
+};
+
+struct SwitchConfig {
+  SwitchQSpec net;               // 2 x 128 ReLU (spec)
+  double lr = 1e-4;              // Adam (spec)
+  int batch = 64;                // minibatch (spec)
+  int replay = 1'000'000;        // replay capacity (spec)
+  int target_every = 500;        // updates between hard target copies (spec)
+  double r_success = 1.0, r_fail = -1.0;
+  int attempts = 2000;           // transition attempts (episodes of Alg. 2)
+  int updates_per_attempt = 8;
+  int warmup = 500;              // stored transitions before the first update
+  // Epsilon is drawn once per attempt; a random attempt switches at a uniform point of
+  // the interval (reference). It decays linearly to epsilon_end over explore_fraction.
+  double epsilon_start = 1.0, epsilon_end = 0.1, explore_fraction = 0.5;
+  int max_subtask_steps = 3000;  // pi_b's run is cut (and counted a success) after this
+
+  static SwitchConfig read(const Section& s);
+};
+
+struct PipelineConfig {
+  std::string run_dir;
+  uint64_t seed = 1;
+  int threads = 0;
+  CollectConfig collect;
+  TransitionPolicyConfig transition;
+  SwitchConfig switching;
+  static PipelineConfig read(const Section& root, const std::string& task);
+};
+
+}  // namespace segue

@@ -1,0 +1,171 @@
+#include "hrl/switch_training.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace segue {
+
+bool run_subtask(Env& env, const CompositeRecipe& r, int to, float* obs, int max_steps) {
+  const Skill& b = r.skills[to];
+  std::vector<float> act(env.spec().act_dim);
+  std::vector<double> f(env.spec().feature_names.size());
+  for (int step = 0; step < max_steps; ++step) {
+    b.policy.act(obs + b.obs_begin, 1, act.data());
+    StepResult sr = env.step(act.data(), obs);
+    if (sr.terminated) return false;
+    if (sr.truncated) return true;
+    env.features(f.data());
+    if (r.meta.active_transition(to, f.data()) >= 0) return true;
+  }
+  return true;
+}
+
+SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& recipe, int transition,
+                             StartStates starts, Policy pi_ab, uint64_t seed)
+    : cfg_(config), recipe_(recipe), tr_(recipe.meta.transitions().at(transition)), starts_(std::move(starts)),
+      pi_ab_(std::move(pi_ab)), env_(recipe.make_env()) {
+  if (starts_.size() == 0) throw Error("switch training: S_a is empty");
+  const EnvSpec& spec = env_->spec();
+  const int D = spec.obs_dim;
+  full_.resize(D), next_full_.resize(D), scratch_.resize(D), qvals_.resize(2);
+  features_.resize(spec.feature_names.size());
+  rng_.seed(seed);
+  torch::manual_seed(mix_seed(seed, 0x9));
+  SwitchQSpec qs = cfg_.net;
+  qs.obs_dim = D;
+  q_ = SwitchQNetwork(qs);
+  target_ = SwitchQNetwork(qs);
+  copy_weights(q_, target_);
+  opt_ = std::make_unique<torch::optim::Adam>(q_->parameters(), torch::optim::AdamOptions(cfg_.lr));
+
+  // Probe pi_ab through the interval from a few starts: how long the interval lasts (for
+  // random attempts) and the scale of the states q_ab will see (its input normaliser).
+  const Skill& b = recipe_.skills[tr_.to];
+  std::vector<float> act(spec.act_dim);
+  std::vector<double> sum(D, 0.0), sq(D, 0.0);
+  int64_t rows = 0, steps = 0;
+  const int probes = std::min(20, starts_.size());
+  for (int p = 0; p < probes; ++p) {
+    state_.assign(starts_.states.begin() + size_t(p) * starts_.state_dim,
+                  starts_.states.begin() + size_t(p + 1) * starts_.state_dim);
+    env_->restore_state(state_, full_.data());
+    for (int t = 0; t < 100000; ++t) {
+      for (int j = 0; j < D; ++j) sum[j] += full_[j], sq[j] += double(full_[j]) * full_[j];
+      ++rows;
+      pi_ab_.act(full_.data() + b.obs_begin, 1, act.data());
+      StepResult sr = env_->step(act.data(), full_.data());
+      env_->features(features_.data());
+      ++steps;
+      if (sr.done() || !MetaController::holds(tr_.when, features_.data())) break;
+    }
+  }
+  interval_length_ = std::max<int>(1, int(steps / probes));
+  mean_.resize(D), inv_std_.resize(D);
+  for (int j = 0; j < D; ++j) {
+    double m = sum[j] / rows, var = std::max(sq[j] / rows - m * m, 0.0);
+    mean_[j] = float(m);
+    inv_std_[j] = float(1.0 / std::max(std::sqrt(var), 1e-2));
+  }
+  q_copy_ = EigenMlp(q_->q, Activation::Relu);
+}
+
+int SwitchTrainer::greedy(const float* obs) {
+  const int D = int(full_.size());
+  for (int j = 0; j < D; ++j) scratch_[j] = std::clamp((obs[j] - mean_[j]) * inv_std_[j], -5.0f, 5.0f);
+  q_copy_.forward(scratch_.data(), 1, qvals_.data());
+  return qvals_[SwitchQNetworkImpl::kSwitch] > qvals_[SwitchQNetworkImpl::kStay] ? SwitchQNetworkImpl::kSwitch
+                                                                                 : SwitchQNetworkImpl::kStay;
+}
+
+void SwitchTrainer::store(const float* s, int a, double r, const float* s2, bool done) {
+  const int D = int(full_.size());
+  const int64_t cap = cfg_.replay, row = stored_ % cap;
+  if (stored_ < cap) {
+    obs_.resize(size_t(row + 1) * D), next_obs_.resize(size_t(row + 1) * D);
+    action_.push_back(0), reward_.push_back(0), done_.push_back(0);
+  }
+  for (int j = 0; j < D; ++j) {
+    obs_[row * D + j] = std::clamp((s[j] - mean_[j]) * inv_std_[j], -5.0f, 5.0f);
+    next_obs_[row * D + j] = std::clamp((s2[j] - mean_[j]) * inv_std_[j], -5.0f, 5.0f);
+  }
+  action_[row] = a, reward_[row] = float(r), done_[row] = done ? 1.0f : 0.0f;
+  ++stored_;
+}
+
+SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
+  const int D = int(full_.size());
+  const Skill& b = recipe_.skills[tr_.to];
+  std::vector<float> act(env_->spec().act_dim);
+  int i = rng_.integer(0, starts_.size() - 1);
+  state_.assign(starts_.states.begin() + size_t(i) * starts_.state_dim,
+                starts_.states.begin() + size_t(i + 1) * starts_.state_dim);
+  env_->restore_state(state_, full_.data());
+  const int switch_at = random ? rng_.integer(0, interval_length_ - 1) : -1;
+  for (int t = 0;; ++t) {
+    int a = random ? (t == switch_at ? SwitchQNetworkImpl::kSwitch : SwitchQNetworkImpl::kStay) : greedy(full_.data());
+    if (a == SwitchQNetworkImpl::kSwitch) {
+      std::copy(full_.begin(), full_.end(), scratch_.begin());
+      bool ok = run_subtask(*env_, recipe_, tr_.to, full_.data(), cfg_.max_subtask_steps);
+      store(scratch_.data(), a, ok ? cfg_.r_success : cfg_.r_fail, scratch_.data(), true);
+      return {ok, t};
+    }
+    pi_ab_.act(full_.data() + b.obs_begin, 1, act.data());
+    StepResult sr = env_->step(act.data(), next_full_.data());
+    env_->features(features_.data());
+    bool left = sr.truncated || !MetaController::holds(tr_.when, features_.data());
+    if (sr.terminated || left) {  // a fall, or the interval ran out while staying
+      store(full_.data(), a, cfg_.r_fail, next_full_.data(), true);
+      return {false, t + 1};
+    }
+    store(full_.data(), a, 0.0, next_full_.data(), false);
+    std::copy(next_full_.begin(), next_full_.begin() + D, full_.begin());
+  }
+}
+
+double SwitchTrainer::update() {
+  const int64_t n = std::min<int64_t>(stored_, cfg_.replay), D = int64_t(full_.size());
+  auto idx = torch::randint(n, {cfg_.batch}, torch::kLong);
+  auto obs = torch::from_blob(obs_.data(), {n, D}).index_select(0, idx);
+  auto next = torch::from_blob(next_obs_.data(), {n, D}).index_select(0, idx);
+  auto action = torch::from_blob(action_.data(), {n}, torch::kLong).index_select(0, idx);
+  auto reward = torch::from_blob(reward_.data(), {n}).index_select(0, idx);
+  auto done = torch::from_blob(done_.data(), {n}).index_select(0, idx);
+  auto loss = double_dqn_loss(q_, target_, obs, action, reward, next, done, cfg_.net.gamma);  // Eq. 4
+  opt_->zero_grad();
+  loss.backward();
+  opt_->step();
+  if (++updates_ % cfg_.target_every == 0) copy_weights(q_, target_);
+  double l = loss.item<double>();
+  if (!std::isfinite(l)) throw Error("switch Q-network loss became " + std::to_string(l));
+  return l;
+}
+
+SwitchStats SwitchTrainer::run(int n) {
+  SwitchStats s;
+  int updates = 0;
+  for (int k = 0; k < n; ++k) {
+    double frac = std::min(1.0, attempts_ / (cfg_.explore_fraction * std::max(cfg_.attempts, 1)));
+    double eps = cfg_.epsilon_start + frac * (cfg_.epsilon_end - cfg_.epsilon_start);
+    Outcome o = attempt(rng_.uniform(0.0, 1.0) < eps);
+    ++attempts_;
+    s.attempts++;
+    s.success_rate += o.success;
+    s.switch_step += o.switch_step;
+    s.epsilon = eps;
+    if (stored_ >= cfg_.warmup) {
+      for (int u = 0; u < cfg_.updates_per_attempt; ++u, ++updates) s.loss += update();
+      q_copy_ = EigenMlp(q_->q, Activation::Relu);
+    }
+  }
+  if (s.attempts) s.success_rate /= s.attempts, s.switch_step /= s.attempts;
+  if (updates) s.loss /= updates;
+  return s;
+}
+
+Policy SwitchTrainer::q_function() const {
+  const float inf = std::numeric_limits<float>::infinity();
+  return Policy(EigenMlp(q_->q, Activation::Relu), mean_, inv_std_, 5.0f, {-inf, -inf}, {inf, inf});
+}
+
+}  // namespace segue

@@ -1,0 +1,75 @@
+#pragma once
+// Algorithm 2: the switch Q-network q_ab, which decides during a transition interval when
+// pi_ab hands control to pi_b. An attempt starts from a state of S_a; at every state q_ab
+// picks stay (pi_ab acts one step) or switch (pi_b takes over and runs its subtask).
+// Rewards (spec): switch -> r_s if pi_b then achieves its subtask, r_f if it fails;
+// stay -> r_f on a fall or on leaving the interval, else 0. Every reward but the
+// uneventful stay ends the attempt. Double DQN (Eq. 4) on a replay buffer, hard target copy.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "algorithms/switch_q_network.h"
+#include "core/rng.h"
+#include "hrl/collection.h"
+#include "hrl/composite_recipe.h"
+#include "hrl/pipeline_config.h"
+
+namespace segue {
+
+// Runs pi_b from the state in `obs` (the task observation, updated in place) until its
+// subtask ends: it succeeds when the meta-controller would start the next transition out
+// of b, when the episode reaches its time limit, or after max_steps; it fails when the
+// episode terminates first (a fall, a contact).
+bool run_subtask(Env& env, const CompositeRecipe& recipe, int to_skill, float* obs, int max_steps);
+
+struct SwitchStats {
+  int attempts = 0;
+  double success_rate = 0;   // of pi_b's subtask, over the attempts in this report
+  double switch_step = 0;    // mean step of the interval where control was handed over
+  double epsilon = 0, loss = 0;
+};
+
+class SwitchTrainer {
+ public:
+  SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& recipe, int transition, StartStates starts,
+                Policy transition_policy, uint64_t seed);
+  // Runs `n` attempts (with their updates) and reports on them.
+  SwitchStats run(int n);
+  int attempts_done() const { return attempts_; }
+  // q_ab as a function of the task observation: forward(obs) -> [Q(stay), Q(switch)],
+  // input normalisation included (exported like a policy, with unbounded outputs).
+  Policy q_function() const;
+
+ private:
+  struct Outcome {
+    bool success;
+    int switch_step;
+  };
+  Outcome attempt(bool random);
+  void store(const float* s, int a, double r, const float* s2, bool done);
+  double update();
+  int greedy(const float* obs);
+
+  SwitchConfig cfg_;
+  const CompositeRecipe& recipe_;
+  const Transition& tr_;
+  StartStates starts_;
+  Policy pi_ab_;
+  std::unique_ptr<Env> env_;
+  SwitchQNetwork q_{nullptr}, target_{nullptr};
+  std::unique_ptr<torch::optim::Adam> opt_;
+  EigenMlp q_copy_;  // per-step inference
+  std::vector<float> mean_, inv_std_;
+  Rng rng_;
+  // Replay buffer, a ring of `replay` rows.
+  std::vector<float> obs_, next_obs_;
+  std::vector<int64_t> action_;
+  std::vector<float> reward_, done_;
+  int64_t stored_ = 0;
+  int attempts_ = 0, updates_ = 0, interval_length_ = 1;
+  std::vector<float> full_, next_full_, scratch_, qvals_;
+  std::vector<double> features_, state_;
+};
+
+}  // namespace segue

@@ -1,0 +1,56 @@
+#include "hrl/transition_controller.h"
+
+namespace segue {
+
+TransitionController::TransitionController(const std::vector<Skill>& skills, const MetaController& meta,
+                                           std::vector<TransitionArtefacts> artefacts, SwitchRule rule)
+    : skills_(skills), meta_(meta), artefacts_(std::move(artefacts)), rule_(rule) {}
+
+void TransitionController::reset(const Env& env, const float*) {
+  features_.resize(env.spec().feature_names.size());
+  env.features(features_.data());
+  skill_ = meta_.start_skill(features_.data());
+  transition_ = -1;
+}
+
+bool TransitionController::hand_over(const float* obs) {
+  const TransitionArtefacts& a = artefacts_[transition_];
+  if (rule_ == SwitchRule::QNetwork && a.q) {
+    float q[2];
+    a.q->act(obs, 1, q);
+    return q[1] > q[0];
+  }
+  return false;
+}
+
+void TransitionController::act(const Env& env, const float* obs, float* action) {
+  env.features(features_.data());
+  if (transition_ >= 0) {
+    const Transition& tr = meta_.transitions()[transition_];
+    if (!MetaController::holds(tr.when, features_.data()) || hand_over(obs)) transition_ = -1;
+  }
+  if (transition_ < 0) {
+    int t = meta_.active_transition(skill_, features_.data());
+    if (t >= 0) {
+      skill_ = meta_.transitions()[t].to;  // pi_b is next, whoever drives the interval
+      if (artefacts_[t].policy) {
+        transition_ = t;
+        if (hand_over(obs)) transition_ = -1;  // q_ab may switch at the interval's first state
+      }
+    }
+  }
+  const Skill& b = skills_[skill_];
+  if (transition_ < 0) {
+    b.policy.act(obs + b.obs_begin, 1, action);
+    return;
+  }
+  const Policy& pi_ab = *artefacts_[transition_].policy;
+  const int A = env.spec().act_dim;
+  out_.resize(pi_ab.act_dim());
+  pi_ab.act(obs + b.obs_begin, 1, out_.data());
+  std::copy(out_.begin(), out_.begin() + A, action);
+  // Lee et al.: the transition policy's own termination output ends it from the next step.
+  if (rule_ == SwitchRule::TerminationHead && pi_ab.act_dim() > A && out_[A] > 0.0f) transition_ = -1;
+}
+
+}  // namespace segue

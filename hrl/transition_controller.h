@@ -1,0 +1,47 @@
+#pragma once
+// With TP, With TP + Q and Lee et al.: the meta-controller's skills joined by trained
+// transition policies. When transition a->b's interval begins, pi_ab takes over from pi_a;
+// control passes to pi_b
+//   IntervalEnd      (With TP):       when the interval ends;
+//   QNetwork         (With TP + Q):   as soon as q_ab values switch above stay;
+//   TerminationHead  (Lee et al.):    when pi_ab's extra output (its termination head) is
+//                                     positive.
+// Control always passes to pi_b when the interval ends. A transition without a trained
+// pi_ab is taken as Without TP.
+#include <optional>
+#include <vector>
+
+#include "hrl/controller.h"
+#include "hrl/meta_controller.h"
+#include "hrl/skill.h"
+
+namespace segue {
+
+enum class SwitchRule { IntervalEnd, QNetwork, TerminationHead };
+
+struct TransitionArtefacts {
+  std::optional<Policy> policy;  // pi_ab, on pi_b's observation slice
+  std::optional<Policy> q;       // q_ab, on the task observation: [Q(stay), Q(switch)]
+};
+
+class TransitionController : public Controller {
+ public:
+  TransitionController(const std::vector<Skill>& skills, const MetaController& meta,
+                       std::vector<TransitionArtefacts> artefacts, SwitchRule rule);
+  void reset(const Env& env, const float* obs) override;
+  void act(const Env& env, const float* obs, float* action) override;
+  int skill() const { return skill_; }
+  int transition() const { return transition_; }  // the transition pi_ab is running, or -1
+
+ private:
+  bool hand_over(const float* obs);
+  std::vector<Skill> skills_;  // own copies: Policy::act keeps scratch buffers
+  const MetaController& meta_;
+  std::vector<TransitionArtefacts> artefacts_;  // per transition of the recipe
+  SwitchRule rule_;
+  std::vector<double> features_;
+  std::vector<float> out_;
+  int skill_ = 0, transition_ = -1;
+};
+
+}  // namespace segue

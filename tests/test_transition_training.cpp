@@ -1,0 +1,227 @@
+// Algorithms 1 and 2 wired together: the transition policy's rewards are Eq. 3 of its own
+// discriminator, pi_ab starts as pi_b, the switch Q-network exports like a policy, the
+// controllers hand over where the recipe says, and `segue run`'s pipeline writes every
+// artefact and resumes.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <filesystem>
+#include <fstream>
+
+#include "environments/registry.h"
+#include "hrl/pipeline.h"
+#include "hrl/switch_training.h"
+#include "hrl/transition_env.h"
+#include "hrl/transition_policy.h"
+#include "temp_dir.h"
+
+namespace segue {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Patrol cut to one transition (forward -> balance) and 300-step episodes, no pushes.
+const char* kTinyPatrol = R"(
+task: patrol
+env: {max_episode_steps: 300, push_prob: 0}
+skills:
+  forward: {policy: assets/policies/walker/walker_forward.pt}
+  backward: {policy: assets/policies/walker/walker_backward.pt}
+  balance: {policy: assets/policies/walker/walker_balance.pt}
+start:
+  - {skill: forward, when: {direction: 1}}
+  - {skill: backward, when: {direction: -1}}
+transitions:
+  - {from: forward, to: balance, when: {since_turn: [0, 100]}, expert: {when: {steps: [0, 100]}}}
+seed: 3
+threads: 1
+collect: {start_states: 12, demonstrations: 400}
+transition:
+  ppo: {total_steps: 2048, num_envs: 4, steps_per_env: 128, minibatch_size: 256, epochs: 2}
+  discriminator: {steps: 4, batch: 64}
+switch: {attempts: 24, warmup: 16, batch: 16, updates_per_attempt: 2}
+eval: {episodes: 3, seeds: [0]}
+)";
+
+class TransitionTraining : public TempDirTest {
+ protected:
+  TransitionTraining() : TempDirTest("transition_training") {}
+  CompositeRecipe tiny(std::vector<std::string> sets = {}) {
+    std::string file = path("tiny_patrol.yaml");
+    std::ofstream(file) << kTinyPatrol;
+    sets.push_back("run_dir=" + path("run"));
+    return CompositeRecipe::load(file, sets);
+  }
+};
+
+std::vector<float> random_obs(int n, int d, uint64_t seed) {
+  Rng rng(seed);
+  std::vector<float> v(size_t(n) * d);
+  for (auto& x : v) x = float(2.0 * rng.normal());
+  return v;
+}
+
+}  // namespace
+
+TEST_F(TransitionTraining, PiAbStartsAsPiB) {
+  CompositeRecipe r = tiny();
+  const Policy& balance = r.skills[2].policy;
+  VectorEnv envs(task_factory("walker_balance", Recipe::parse("{}", "b").root()), 2, 1);
+  ActorCriticSpec net;
+  net.obs_dim = balance.obs_dim(), net.act_dim = balance.act_dim();
+  net.vf_hidden = {64, 64};
+  PPO ppo(PpoConfig(), net, envs, 1);
+  ppo.init_actor(balance);
+  auto obs = random_obs(16, net.obs_dim, 5);
+  std::vector<float> want(16 * 6), got(16 * 6);
+  balance.act(obs.data(), 16, want.data());
+  ppo.policy().act(obs.data(), 16, got.data());
+  for (size_t i = 0; i < want.size(); ++i) ASSERT_NEAR(got[i], want[i], 1e-4) << i;
+}
+
+TEST_F(TransitionTraining, GeneratorRewardsAreEq3OfTheDiscriminator) {
+  for (std::string mode : {"airl", "airl_absorbing"}) {
+    CompositeRecipe r = tiny({"transition.reward=" + mode, "transition.discriminator.steps=16"});
+    const TransitionPolicyConfig& cfg = r.pipeline.transition;
+    const Transition& tr = r.meta.transitions()[0];
+    const Skill& b = r.skills[tr.to];
+    StartStates starts = collect_start_states(r, 0, 6, 1);
+    VectorEnv envs([&] { return std::make_unique<TransitionEnv>(r.make_env(), starts, tr.when, b.obs_begin, b.obs_end); },
+                   cfg.ppo.num_envs, 1);
+    TransitionPolicyTrainer trainer(cfg, envs, collect_demonstrations(r, 0, 300, 2), b.policy, 7);
+    std::vector<double> losses;
+    for (int i = 0; i < 6; ++i) losses.push_back(trainer.iterate().disc_loss);
+    // The discriminator learns to tell pi_b's steps from pi_ab's (log 2 at chance).
+    EXPECT_LT(losses.back(), losses.front()) << mode;
+    EXPECT_LT(losses.back(), std::log(2.0)) << mode;
+
+    // Recompute the last rollout's rewards independently of the hook.
+    const RolloutBuffer& buf = trainer.ppo().buffer();
+    const int64_t M = int64_t(buf.T) * buf.N, D = buf.obs_dim, A = buf.act_dim;
+    auto obs = torch::from_blob(const_cast<float*>(buf.raw_obs.data()), {M, D});
+    auto next = torch::from_blob(const_cast<float*>(buf.next_raw_obs.data()), {M, D});
+    auto act = torch::from_blob(const_cast<float*>(buf.actions.data()), {M, A}).clamp(-1.0, 1.0);
+    auto logp = torch::from_blob(const_cast<float*>(buf.log_probs.data()), {M});
+    std::vector<float> done(M, 0.0f);
+    std::vector<bool> truncated(M, false);
+    for (int k : buf.truncated_index) truncated[k] = true;
+    int falls = 0;
+    for (int64_t k = 0; k < M; ++k) done[k] = buf.dones[k] && !truncated[k], falls += done[k] > 0;
+    auto reward = trainer.discriminator()->reward(obs, act, next, torch::from_blob(done.data(), {M}), logp);
+    // Eq. 3 is the logit of D: log D - log(1 - D) with D = exp f / (exp f + pi).
+    auto f = trainer.discriminator()->f(obs, act, next, torch::from_blob(done.data(), {M})).detach();
+    auto d = torch::exp(f) / (torch::exp(f) + torch::exp(logp));
+    EXPECT_TRUE(torch::allclose(reward, torch::log(d) - torch::log(1 - d), 1e-3, 1e-3)) << mode;
+    double worst = reward.min().item<double>(), gamma = cfg.ppo.gamma;
+    for (int64_t k = 0; k < M; ++k) {
+      double want = reward[k].item<double>();
+      if (mode == "airl_absorbing" && done[k]) want += gamma * std::min(worst, 0.0) / (1 - gamma);
+      ASSERT_NEAR(buf.raw_rewards[k], want, 1e-3 * std::max(1.0, std::abs(want))) << mode << " row " << k;
+    }
+    if (mode == "airl_absorbing") EXPECT_GT(falls, 0) << "the check of the absorbing term saw no fall";
+  }
+}
+
+TEST_F(TransitionTraining, SwitchQNetworkExportsAsAPolicy) {
+  CompositeRecipe r = tiny();
+  const Skill& b = r.skills[r.meta.transitions()[0].to];
+  SwitchTrainer trainer(r.pipeline.switching, r, 0, collect_start_states(r, 0, 6, 1), b.policy, 4);
+  SwitchStats s = trainer.run(24);
+  EXPECT_EQ(s.attempts, 24);
+  EXPECT_GE(s.success_rate, 0.0);
+  EXPECT_LE(s.success_rate, 1.0);
+  EXPECT_GT(s.loss, 0.0);  // updates ran (warmup 16 rows)
+  Policy q = trainer.q_function();
+  ASSERT_EQ(q.obs_dim(), r.spec.obs_dim);
+  ASSERT_EQ(q.act_dim(), 2);
+  q.export_torchscript(path("q.pt"));
+  Policy back = Policy::load(path("q.pt"));
+  auto obs = random_obs(8, q.obs_dim(), 3);
+  std::vector<float> a(16), c(16);
+  q.act(obs.data(), 8, a.data());
+  back.act(obs.data(), 8, c.data());
+  for (int i = 0; i < 16; ++i) EXPECT_NEAR(a[i], c[i], 1e-5);
+}
+
+TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
+  CompositeRecipe r = tiny();
+  const Transition& tr = r.meta.transitions()[0];
+  std::vector<TransitionArtefacts> art(1);
+  art[0].policy = r.skills[tr.to].policy;  // any policy on balance's slice will do
+  auto env = r.make_env();
+  std::vector<float> obs(r.spec.obs_dim), act(6);
+  std::vector<double> f(r.spec.feature_names.size());
+  // With TP: pi_ab drives exactly while the interval holds, pi_b after it.
+  TransitionController tp(r.skills, r.meta, art, SwitchRule::IntervalEnd);
+  int driven = 0;
+  for (uint64_t seed = 0; seed < 20; ++seed) {  // an episode that starts walking forward
+    env->reset(seed, obs.data());
+    tp.reset(*env, obs.data());
+    if (tp.skill() == tr.from) break;
+  }
+  ASSERT_EQ(tp.skill(), tr.from);
+  for (int t = 0; t < 300; ++t) {
+    tp.act(*env, obs.data(), act.data());
+    env->features(f.data());
+    if (tp.transition() >= 0) {
+      ++driven;
+      ASSERT_TRUE(MetaController::holds(tr.when, f.data())) << t;
+      ASSERT_EQ(tp.skill(), tr.to);
+    }
+    if (env->step(act.data(), obs.data()).done()) break;
+  }
+  EXPECT_GT(driven, 0) << "the episode never reached the interval";
+  // With TP + Q where q_ab always prefers switch: pi_b from the interval's first state,
+  // which is Without TP, action for action.
+  EigenMlp always_switch({torch::zeros({2, r.spec.obs_dim})}, {torch::tensor({0.0f, 1.0f})}, Activation::Relu);
+  art[0].q = Policy(always_switch, std::vector<float>(r.spec.obs_dim, 0.0f), std::vector<float>(r.spec.obs_dim, 1.0f),
+                    5.0f, {-1e9f, -1e9f}, {1e9f, 1e9f});
+  TransitionController tpq(r.skills, r.meta, art, SwitchRule::QNetwork);
+  auto without = method_controllers(r, "without-tp")();
+  auto e1 = r.make_env(), e2 = r.make_env();
+  std::vector<float> o1(obs.size()), o2(obs.size()), a1(6), a2(6);
+  e1->reset(77, o1.data());
+  e2->reset(77, o2.data());
+  tpq.reset(*e1, o1.data());
+  without->reset(*e2, o2.data());
+  for (int t = 0; t < 300; ++t) {
+    tpq.act(*e1, o1.data(), a1.data());
+    without->act(*e2, o2.data(), a2.data());
+    ASSERT_EQ(a1, a2) << t;
+    ASSERT_LT(tpq.transition(), 0);
+    if (e1->step(a1.data(), o1.data()).done() | e2->step(a2.data(), o2.data()).done()) break;
+  }
+}
+
+TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
+  CompositeRecipe r = tiny();
+  PipelineOptions o;
+  o.command = "test";
+  // Stopped at once: collection finishes, the transition stage checkpoints after one
+  // iteration and the run returns the signal.
+  std::atomic<int> stop{15};
+  o.stop = &stop;
+  EXPECT_EQ(run_pipeline(r, o), 15);
+  const std::string t = path("run/forward-balance/");
+  EXPECT_TRUE(fs::exists(t + "transition_checkpoint.pt"));
+  EXPECT_FALSE(fs::exists(t + "policy.pt"));
+  // Resumed: every stage finishes, each iteration logged once.
+  stop = 0;
+  EXPECT_EQ(run_pipeline(r, o), 0);
+  for (const char* f : {"start_states.pt", "demonstrations.pt", "policy.pt", "q.pt", "transition.csv", "switch.csv"})
+    EXPECT_TRUE(fs::exists(t + f)) << f;
+  std::ifstream csv(t + "transition.csv");
+  int lines = 0;
+  for (std::string line; std::getline(csv, line);) ++lines;
+  EXPECT_EQ(lines, 1 + 4);  // header + 2048 / (4 x 128) iterations
+  std::ifstream json(path("run/patrol.json"));
+  std::string text((std::istreambuf_iterator<char>(json)), {});
+  for (const char* m : {"\"without-tp\"", "\"tp\"", "\"tp+q\""}) EXPECT_NE(text.find(m), std::string::npos) << m;
+  // A finished run skips its training stages: their outputs are left as they were.
+  auto before = fs::last_write_time(t + "policy.pt"), q_before = fs::last_write_time(t + "q.pt");
+  EXPECT_EQ(run_pipeline(r, o), 0);
+  EXPECT_EQ(fs::last_write_time(t + "policy.pt"), before);
+  EXPECT_EQ(fs::last_write_time(t + "q.pt"), q_before);
+}
+
+}  // namespace segue
