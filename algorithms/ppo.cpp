@@ -231,8 +231,8 @@ torch::Tensor PPO::log_prob(const float* raw_obs, const float* actions, int64_t 
   return net_->log_prob(net_->mean(obs), act);
 }
 
-void PPO::init_actor(const Policy& p) {
-  if (p.obs_dim() != buf_.obs_dim || p.act_dim() != buf_.act_dim)
+void PPO::init_actor(const Policy& p, float extra_bias) {
+  if (p.obs_dim() != buf_.obs_dim || p.act_dim() > buf_.act_dim)
     throw Error("init_actor: the policy's sizes differ from the trainer's");
   const auto& ws = p.mlp().weights();
   const auto& bs = p.mlp().biases();
@@ -241,10 +241,17 @@ void PPO::init_actor(const Policy& p) {
   for (auto& m : net_->actor->modules(/*include_self=*/false)) {
     auto* linear = m->as<torch::nn::Linear>();
     if (!linear) continue;
-    if (layer >= ws.size() || linear->weight.size(0) != ws[layer].rows() || linear->weight.size(1) != ws[layer].cols())
+    const bool last = layer + 1 == ws.size();
+    const int64_t rows = ws.size() > layer ? ws[layer].rows() : -1;
+    if (layer >= ws.size() || linear->weight.size(1) != ws[layer].cols() ||
+        (last ? linear->weight.size(0) < rows : linear->weight.size(0) != rows))
       throw Error("init_actor: the policy's hidden layers differ from the trainer's");
-    linear->weight.copy_(torch::from_blob(const_cast<float*>(ws[layer].data()), {ws[layer].rows(), ws[layer].cols()}));
-    linear->bias.copy_(torch::from_blob(const_cast<float*>(bs[layer].data()), {bs[layer].cols()}));
+    if (last && linear->weight.size(0) > rows) {
+      linear->weight.zero_();
+      linear->bias.fill_(extra_bias);
+    }
+    linear->weight.narrow(0, 0, rows).copy_(torch::from_blob(const_cast<float*>(ws[layer].data()), {rows, ws[layer].cols()}));
+    linear->bias.narrow(0, 0, rows).copy_(torch::from_blob(const_cast<float*>(bs[layer].data()), {rows}));
     ++layer;
   }
   if (layer != ws.size()) throw Error("init_actor: the policy's hidden layers differ from the trainer's");

@@ -77,10 +77,11 @@ class PPO {
   // log pi(a|s) of the current policy at raw (unnormalised) observations, no gradient:
   // AIRL's D needs the generator's density at the expert's actions (Eq. 2).
   torch::Tensor log_prob(const float* raw_obs, const float* actions, int64_t n);
-  // Starts the actor from a trained policy of the same sizes (weights and observation
-  // normaliser); the log std keeps its initial value. A transition policy can start as
-  // pi_b, whose behaviour it is trained to match.
-  void init_actor(const Policy& policy);
+  // Starts the actor from a trained policy (weights and observation normaliser); the log
+  // std keeps its initial value. A transition policy can start as pi_b, whose behaviour it
+  // is trained to match. The actor may have more outputs than the policy (Lee et al.'s
+  // termination head): those start at zero weight and bias `extra_bias`.
+  void init_actor(const Policy& policy, float extra_bias = 0.0f);
 
   // Checkpoint: network, optimiser, normalisers, counters and `note` (the resolved
   // recipe), written atomically. `extra` adds an owner's state (a discriminator) to the

@@ -12,6 +12,7 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   s.threads = root.get("threads", s.threads);
   s.run_dir = root.get("run_dir", default_run_dir);
   s.checkpoint_every = root.get("checkpoint_every", s.checkpoint_every);
+  s.init_from = root.get<std::string>("init_from", "");
   try {
     s.make_env = task_factory(s.task, root.sub("env"));
   } catch (const Error& e) {

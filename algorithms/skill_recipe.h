@@ -6,6 +6,7 @@
 //   threads: 0                # 0 = every core
 //   run_dir: runs/walker_forward
 //   checkpoint_every: 5       # iterations
+//   init_from: runs/walker_jump/checkpoint.pt   # optional: continue an earlier run
 //   env: {...}                # the task's settings (reference defaults)
 //   policy: {pi_hidden: [32, 32], vf_hidden: [32, 32], activation: tanh, init_log_std: -0.5}
 //   ppo: {...}                # see PpoConfig
@@ -29,6 +30,10 @@ struct SkillRecipe {
   uint64_t seed = 1;
   int threads = 0;
   std::string run_dir;
+  // A checkpoint a new run starts from (network, optimiser, normalisers and counters):
+  // a later training stage, e.g. a harder curriculum, continues an earlier run's
+  // budget. "" = from scratch.
+  std::string init_from;
   int checkpoint_every = 5;
   int eval_episodes = 50;
   uint64_t eval_seed = 1000;

@@ -3,9 +3,11 @@
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
+#include <sstream>
 
 #include "core/progress.h"
 #include "core/run_dir.h"
+#include "hrl/lee_transition.h"
 #include "hrl/results_table.h"
 #include "hrl/switch_training.h"
 #include "hrl/transition_env.h"
@@ -43,69 +45,156 @@ void collect(const CompositeRecipe& r, int t, const std::string& run, const std:
   }
 }
 
-// Returns the signal number when stopped, else 0.
-int train_transition(const CompositeRecipe& r, int t, const std::string& dir, const PipelineOptions& o) {
-  const TransitionPolicyConfig& cfg = r.pipeline.transition;
-  const Transition& tr = r.meta.transitions()[t];
-  const Skill& b = r.skills[tr.to];
-  StartStates starts = load_start_states(dir + "/start_states.pt");
-  Demonstrations expert = load_demonstrations(dir + "/demonstrations.pt");
-  VectorEnv envs(
-      [&] { return std::make_unique<TransitionEnv>(r.make_env(), starts, tr.when, b.obs_begin, b.obs_end); },
-      cfg.ppo.num_envs, o.threads);
-  TransitionPolicyTrainer trainer(cfg, envs, std::move(expert), b.policy, mix_seed(r.pipeline.seed, 100 + t));
-  const std::string ckpt = dir + "/transition_checkpoint.pt";
-  if (exists(ckpt)) {
-    trainer.load(ckpt);
-    spdlog::info("  resuming from iteration {} ({} steps)", trainer.ppo().iteration(), trainer.ppo().global_step());
-  }
-  MetricsCsv csv(dir + "/transition.csv",
-                 {"iteration", "global_step", "episodes", "interval_completed", "episode_length", "airl_reward",
-                  "disc_loss", "expert_accuracy", "generator_accuracy", "policy_loss", "value_loss", "approx_kl",
-                  "wall_seconds"},
-                 trainer.ppo().iteration());
-  Progress progress(r.transition_name(t) + " pi_ab", cfg.ppo.total_steps, trainer.ppo().global_step());
-  double completed = NAN;
-  while (trainer.ppo().global_step() < cfg.ppo.total_steps) {
-    TransitionIterationStats s = trainer.iterate();
-    if (s.ppo.episodes > 0) completed = s.ppo.success_rate;
-    csv.write({double(s.ppo.iteration), double(s.ppo.global_step), double(s.ppo.episodes), s.ppo.success_rate,
-               s.ppo.episode_length, s.airl_reward, s.disc_loss, s.expert_accuracy, s.generator_accuracy,
-               s.ppo.policy_loss, s.ppo.value_loss, s.ppo.approx_kl, trainer.ppo().wall_seconds()});
-    bool last = trainer.ppo().global_step() >= cfg.ppo.total_steps;
+// PPO iterations of `trainer` (a TransitionPolicyTrainer or LeeTrainer) to the budget,
+// with checkpoints; `row` turns an iteration's stats into its CSV row. Returns the signal
+// number when stopped, else 0.
+template <class Trainer, class Row>
+int train_loop(Trainer& trainer, const CompositeRecipe& r, int64_t total_steps, const std::string& label,
+               const std::string& ckpt, MetricsCsv& csv, const PipelineOptions& o, Row row) {
+  Progress progress(label, total_steps, trainer.ppo().global_step());
+  double recent = NAN;
+  while (trainer.ppo().global_step() < total_steps) {
+    auto s = trainer.iterate();
+    if (s.ppo.episodes > 0) recent = s.ppo.success_rate;
+    csv.write(row(s));
+    bool last = trainer.ppo().global_step() >= total_steps;
     int stop = o.stop ? o.stop->load() : 0;
     if (last || stop || s.ppo.iteration % 10 == 0) trainer.save(ckpt, r.resolved);
-    // "success" here: episodes that reach the interval's end on their feet.
-    progress.update(trainer.ppo().global_step(), s.airl_reward, completed);
+    progress.update(trainer.ppo().global_step(), s.ppo.episode_return, recent);
     if (stop && !last) {
       progress.finish();
       return stop;
     }
   }
   progress.finish();
-  trainer.policy().export_torchscript(dir + "/policy.pt");
-  spdlog::info("  pi_ab: {} steps in {}; {:.0f}% of its last episodes reached the interval's end",
-               trainer.ppo().global_step(), format_duration(trainer.ppo().wall_seconds()), 100 * completed);
+  spdlog::info("  {}: {} steps in {}; success {:.0f}% in its last episodes", label, trainer.ppo().global_step(),
+               format_duration(trainer.ppo().wall_seconds()), 100 * recent);
   return 0;
+}
+
+template <class Trainer>
+void resume(Trainer& trainer, const std::string& ckpt) {
+  if (!exists(ckpt)) return;
+  trainer.load(ckpt);
+  spdlog::info("  resuming from iteration {} ({} steps)", trainer.ppo().iteration(), trainer.ppo().global_step());
+}
+
+// Algorithm 1. "success" in its log: episodes that reach the interval's end on their feet.
+int train_transition(const CompositeRecipe& r, int t, const std::string& dir, const PipelineOptions& o) {
+  const TransitionPolicyConfig& cfg = r.pipeline.transition;
+  const Transition& tr = r.meta.transitions()[t];
+  const Skill& b = r.skills[tr.to];
+  StartStates starts = load_start_states(dir + "/start_states.pt");
+  VectorEnv envs(
+      [&] { return std::make_unique<TransitionEnv>(r.make_env(), starts, tr.when, b.obs_begin, b.obs_end); },
+      cfg.ppo.num_envs, o.threads);
+  TransitionPolicyTrainer trainer(cfg, envs, load_demonstrations(dir + "/demonstrations.pt"), b.policy,
+                                  mix_seed(r.pipeline.seed, 100 + t));
+  const std::string ckpt = dir + "/transition_checkpoint.pt";
+  resume(trainer, ckpt);
+  MetricsCsv csv(dir + "/transition.csv",
+                 {"iteration", "global_step", "episodes", "interval_completed", "episode_length", "airl_reward",
+                  "disc_loss", "expert_accuracy", "generator_accuracy", "policy_loss", "value_loss", "approx_kl",
+                  "wall_seconds"},
+                 trainer.ppo().iteration());
+  int stop = train_loop(trainer, r, cfg.ppo.total_steps, r.transition_name(t) + " pi_ab", ckpt, csv, o,
+                        [&](const TransitionIterationStats& s) -> std::vector<double> {
+                          return {double(s.ppo.iteration), double(s.ppo.global_step), double(s.ppo.episodes),
+                                  s.ppo.success_rate, s.ppo.episode_length, s.airl_reward, s.disc_loss,
+                                  s.expert_accuracy, s.generator_accuracy, s.ppo.policy_loss, s.ppo.value_loss,
+                                  s.ppo.approx_kl, trainer.ppo().wall_seconds()};
+                        });
+  if (!stop) trainer.policy().export_torchscript(dir + "/policy.pt");
+  return stop;
+}
+
+// Lee et al. 2019. "success" in its log: hand-overs after which pi_b succeeded.
+int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const PipelineOptions& o) {
+  const TransitionPolicyConfig& cfg = r.pipeline.transition;
+  const Skill& b = r.skills[r.meta.transitions()[t].to];
+  StartStates starts = load_start_states(dir + "/start_states.pt");
+  const int subtask_steps = r.pipeline.switching.max_subtask_steps;
+  VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r, t, starts, subtask_steps); }, cfg.ppo.num_envs,
+                 o.threads);
+  LeeTrainer trainer(cfg, r.pipeline.lee, envs, load_demonstrations(dir + "/demonstrations.pt"), b.policy,
+                     mix_seed(r.pipeline.seed, 300 + t));
+  const std::string ckpt = dir + "/lee_checkpoint.pt";
+  resume(trainer, ckpt);
+  MetricsCsv csv(dir + "/lee.csv",
+                 {"iteration", "global_step", "episodes", "handover_success", "episode_length", "predictor_loss",
+                  "policy_loss", "value_loss", "approx_kl", "wall_seconds"},
+                 trainer.ppo().iteration());
+  int stop = train_loop(trainer, r, cfg.ppo.total_steps, r.transition_name(t) + " Lee", ckpt, csv, o,
+                        [&](const LeeTrainer::Stats& s) -> std::vector<double> {
+                          return {double(s.ppo.iteration), double(s.ppo.global_step), double(s.ppo.episodes),
+                                  s.handover_success, s.ppo.episode_length, s.predictor_loss, s.ppo.policy_loss,
+                                  s.ppo.value_loss, s.ppo.approx_kl, trainer.ppo().wall_seconds()};
+                        });
+  if (!stop) trainer.policy().export_torchscript(dir + "/lee.pt");
+  return stop;
 }
 
 void train_switch(const CompositeRecipe& r, int t, const std::string& dir) {
   const SwitchConfig& cfg = r.pipeline.switching;
   SwitchTrainer trainer(cfg, r, t, load_start_states(dir + "/start_states.pt"), Policy::load(dir + "/policy.pt"),
                         mix_seed(r.pipeline.seed, 200 + t));
-  MetricsCsv csv(dir + "/switch.csv", {"attempts", "epsilon", "subtask_success", "switch_step", "loss"}, 0);
+  MetricsCsv csv(dir + "/switch.csv", {"attempts", "epsilon", "subtask_success", "switch_step", "loss", "env_steps", "wall_seconds"}, 0);
   const int chunk = 100;
   auto t0 = std::chrono::steady_clock::now();
   SwitchStats s;
   while (trainer.attempts_done() < cfg.attempts) {
     s = trainer.run(std::min(chunk, cfg.attempts - trainer.attempts_done()));
-    csv.write({double(trainer.attempts_done()), s.epsilon, s.success_rate, s.switch_step, s.loss});
+    double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    csv.write({double(trainer.attempts_done()), s.epsilon, s.success_rate, s.switch_step, s.loss,
+               double(trainer.env_steps()), secs});
     spdlog::info("  q_ab: {}/{} attempts, epsilon {:.2f}, pi_b succeeded in {:.0f}%, switch at step {:.1f}",
                  trainer.attempts_done(), cfg.attempts, s.epsilon, 100 * s.success_rate, s.switch_step);
   }
   trainer.q_function().export_torchscript(dir + "/q.pt");
   double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  spdlog::info("  q_ab: {} attempts in {}", cfg.attempts, format_duration(secs));
+  spdlog::info("  q_ab: {} attempts, {} environment steps in {}", cfg.attempts, trainer.env_steps(),
+               format_duration(secs));
+}
+
+// Fig. 4's data: from the same S_a states, each of pi_a, pi_ab and pi_b drives through
+// the interval; every action is a row "label,a0,...".
+void write_actions(const CompositeRecipe& r, int t, const std::string& dir, int starts_used = 40) {
+  const Transition& tr = r.meta.transitions()[t];
+  const Skill& a = r.skills[tr.from];
+  const Skill& b = r.skills[tr.to];
+  StartStates starts = load_start_states(dir + "/start_states.pt");
+  Policy pi_ab = Policy::load(dir + "/policy.pt");
+  auto env = r.make_env();
+  std::vector<float> obs(r.spec.obs_dim), act(r.spec.act_dim);
+  std::vector<double> f(r.spec.feature_names.size()), state;
+  std::ostringstream csv;
+  csv << "label";
+  for (int j = 0; j < r.spec.act_dim; ++j) csv << ",a" << j;
+  csv << "\n";
+  struct Driver {
+    const char* label;
+    const Policy* policy;
+    int begin;
+  };
+  const std::string la = "pi_" + a.name, lab = "pi_" + a.name + "_" + b.name, lb = "pi_" + b.name;
+  const Driver drivers[3] = {{la.c_str(), &a.policy, a.obs_begin}, {lab.c_str(), &pi_ab, b.obs_begin},
+                             {lb.c_str(), &b.policy, b.obs_begin}};
+  for (const Driver& d : drivers)
+    for (int i = 0; i < std::min(starts_used, starts.size()); ++i) {
+      state.assign(starts.states.begin() + size_t(i) * starts.state_dim,
+                   starts.states.begin() + size_t(i + 1) * starts.state_dim);
+      env->restore_state(state, obs.data());
+      for (int step = 0; step < 1000; ++step) {
+        d.policy->act(obs.data() + d.begin, 1, act.data());
+        csv << d.label;
+        for (float x : act) csv << "," << x;
+        csv << "\n";
+        if (env->step(act.data(), obs.data()).done()) break;
+        env->features(f.data());
+        if (!MetaController::holds(tr.when, f.data())) break;
+      }
+    }
+  write_file_atomic(dir + "/actions.csv", csv.str());
 }
 
 }  // namespace
@@ -114,7 +203,8 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
   const std::string run = recipe.pipeline.run_dir;
   RunDir dir(run, recipe.resolved);
   const int n = int(recipe.meta.transitions().size());
-  const int stages = 3 * n + 1;
+  const bool lee = recipe.pipeline.lee.enabled;
+  const int stages = (lee ? 4 : 3) * n + 1;
   int stage = 0;
   auto announce = [&](const std::string& what) { spdlog::info("[stage {}/{}] {}", ++stage, stages, what); };
   for (int t = 0; t < n; ++t) {
@@ -135,8 +225,17 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
     else
       train_switch(recipe, t, tdir);
     if (o.stop && o.stop->load()) return o.stop->load();
+    if (!lee) continue;
+    announce(name + ": Lee et al. 2019 baseline (proximity reward, termination head)");
+    if (exists(tdir + "/lee.pt")) {
+      spdlog::info("  done already: {}/lee.pt", tdir);
+    } else if (int stop = train_lee(recipe, t, tdir, o)) {
+      spdlog::warn("interrupted: checkpoint saved; rerun the same command to resume");
+      return stop;
+    }
   }
   announce("evaluate every method");
+  for (int t = 0; t < n; ++t) write_actions(recipe, t, run + "/" + recipe.transition_name(t));
   CompositeRecipe trained = recipe;
   trained.transitions_dir = fs::absolute(run).string();
   std::vector<std::pair<std::string, std::string>> skipped;

@@ -5,8 +5,12 @@
 //   2. transition  NAME/policy.pt (pi_ab, TorchScript), NAME/transition.csv; training
 //                  checkpoints to NAME/transition_checkpoint.pt and resumes from it
 //   3. switch      NAME/q.pt (q_ab, TorchScript), NAME/switch.csv
+//   4. lee         NAME/lee.pt (Lee et al.'s transition policy, TorchScript), NAME/lee.csv;
+//                  checkpoints to NAME/lee_checkpoint.pt (recipe key lee.enabled)
 // and finally
-//   4. evaluate    TASK.md / TASK.json: every method whose artefacts exist
+//   5. evaluate    TASK.md / TASK.json: every method whose artefacts exist; NAME/actions.csv,
+//                  the actions of pi_a, pi_ab and pi_b from the same S_a states through the
+//                  interval (paper Fig. 4: tools/tsne_actions.py draws it)
 // A stage whose outputs exist is skipped, so rerunning an interrupted run resumes it.
 #include <atomic>
 #include <string>

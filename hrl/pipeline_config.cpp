@@ -63,6 +63,22 @@ SwitchConfig SwitchConfig::read(const Section& s) {
   return c;
 }
 
+LeeConfig LeeConfig::read(const Section& s) {
+  LeeConfig c;
+  c.enabled = s.get("enabled", c.enabled);
+  c.hidden = s.get("hidden", c.hidden);
+  c.lr = s.get("lr", c.lr);
+  c.batch = s.get("batch", c.batch);
+  c.steps = s.get("steps", c.steps);
+  c.decay = s.get("decay", c.decay);
+  c.max_rows = s.get("max_rows", c.max_rows);
+  c.termination_bias = s.get("termination_bias", c.termination_bias);
+  if (c.batch <= 0) throw s.error("batch", "must be positive");
+  if (c.max_rows <= 0) throw s.error("max_rows", "must be positive");
+  if (!(c.decay > 0 && c.decay <= 1)) throw s.error("decay", "must be in (0, 1]");
+  return c;
+}
+
 PipelineConfig PipelineConfig::read(const Section& root, const std::string& task) {
   PipelineConfig c;
   c.run_dir = root.get("run_dir", "runs/" + task);
@@ -71,6 +87,7 @@ PipelineConfig PipelineConfig::read(const Section& root, const std::string& task
   c.collect = CollectConfig::read(root.sub("collect"));
   c.transition = TransitionPolicyConfig::read(root.sub("transition"));
   c.switching = SwitchConfig::read(root.sub("switch"));
+  c.lee = LeeConfig::read(root.sub("lee"));
   return c;
 }
 

@@ -66,6 +66,20 @@ struct SwitchConfig {
   static SwitchConfig read(const Section& s);
 };
 
+// Lee et al. 2019's transition policy: the generator's PPO and network are `transition:`'s;
+// these are its proximity predictor's and termination head's settings.
+struct LeeConfig {
+  bool enabled = true;         // train the baseline in `segue run`
+  std::vector<int> hidden{96, 96};  // P: 2 x 96 ReLU (spec)
+  double lr = 3e-4;            // Adam, least squares
+  int batch = 64;
+  int steps = 32;              // predictor steps per PPO iteration
+  double decay = 0.95;         // label 0.95^k, k steps before a successful hand-over
+  int max_rows = 200000;       // labelled states kept per class (a ring)
+  float termination_bias = -1.0f;  // initial termination output (mean): rarely at first
+  static LeeConfig read(const Section& s);
+};
+
 struct PipelineConfig {
   std::string run_dir;
   uint64_t seed = 1;
@@ -73,6 +87,7 @@ struct PipelineConfig {
   CollectConfig collect;
   TransitionPolicyConfig transition;
   SwitchConfig switching;
+  LeeConfig lee;
   static PipelineConfig read(const Section& root, const std::string& task);
 };
 

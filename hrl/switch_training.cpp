@@ -6,13 +6,14 @@
 
 namespace segue {
 
-bool run_subtask(Env& env, const CompositeRecipe& r, int to, float* obs, int max_steps) {
+bool run_subtask(Env& env, const CompositeRecipe& r, int to, float* obs, int max_steps, int64_t* steps) {
   const Skill& b = r.skills[to];
   std::vector<float> act(env.spec().act_dim);
   std::vector<double> f(env.spec().feature_names.size());
   for (int step = 0; step < max_steps; ++step) {
     b.policy.act(obs + b.obs_begin, 1, act.data());
     StepResult sr = env.step(act.data(), obs);
+    if (steps) ++*steps;
     if (sr.terminated) return false;
     if (sr.truncated) return true;
     env.features(f.data());
@@ -106,12 +107,13 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
     int a = random ? (t == switch_at ? SwitchQNetworkImpl::kSwitch : SwitchQNetworkImpl::kStay) : greedy(full_.data());
     if (a == SwitchQNetworkImpl::kSwitch) {
       std::copy(full_.begin(), full_.end(), scratch_.begin());
-      bool ok = run_subtask(*env_, recipe_, tr_.to, full_.data(), cfg_.max_subtask_steps);
+      bool ok = run_subtask(*env_, recipe_, tr_.to, full_.data(), cfg_.max_subtask_steps, &env_steps_);
       store(scratch_.data(), a, ok ? cfg_.r_success : cfg_.r_fail, scratch_.data(), true);
       return {ok, t};
     }
     pi_ab_.act(full_.data() + b.obs_begin, 1, act.data());
     StepResult sr = env_->step(act.data(), next_full_.data());
+    ++env_steps_;
     env_->features(features_.data());
     bool left = sr.truncated || !MetaController::holds(tr_.when, features_.data());
     if (sr.terminated || left) {  // a fall, or the interval ran out while staying

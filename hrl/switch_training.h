@@ -21,7 +21,9 @@ namespace segue {
 // subtask ends: it succeeds when the meta-controller would start the next transition out
 // of b, when the episode reaches its time limit, or after max_steps; it fails when the
 // episode terminates first (a fall, a contact).
-bool run_subtask(Env& env, const CompositeRecipe& recipe, int to_skill, float* obs, int max_steps);
+// `steps` (optional) is increased by the environment steps taken.
+bool run_subtask(Env& env, const CompositeRecipe& recipe, int to_skill, float* obs, int max_steps,
+                 int64_t* steps = nullptr);
 
 struct SwitchStats {
   int attempts = 0;
@@ -37,6 +39,8 @@ class SwitchTrainer {
   // Runs `n` attempts (with their updates) and reports on them.
   SwitchStats run(int n);
   int attempts_done() const { return attempts_; }
+  // Environment steps so far: pi_ab's in the interval and pi_b's subtasks after switches.
+  int64_t env_steps() const { return env_steps_; }
   // q_ab as a function of the task observation: forward(obs) -> [Q(stay), Q(switch)],
   // input normalisation included (exported like a policy, with unbounded outputs).
   Policy q_function() const;
@@ -68,6 +72,7 @@ class SwitchTrainer {
   std::vector<float> reward_, done_;
   int64_t stored_ = 0;
   int attempts_ = 0, updates_ = 0, interval_length_ = 1;
+  int64_t env_steps_ = 0;
   std::vector<float> full_, next_full_, scratch_, qvals_;
   std::vector<double> features_, state_;
 };

@@ -24,6 +24,8 @@ class TransitionEnv : public Env {
   void save_state(std::vector<double>& out) const override { task_->save_state(out); }
   void restore_state(const std::vector<double>& state, float* obs) override;
   Env& task() { return *task_; }
+  // The task's whole observation after the last reset or step (pi_ab sees a slice of it).
+  const std::vector<float>& task_obs() const { return full_; }
 
  private:
   void slice(float* obs) const;

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "environments/registry.h"
+#include "hrl/lee_transition.h"
 #include "hrl/pipeline.h"
 #include "hrl/switch_training.h"
 #include "hrl/transition_env.h"
@@ -193,6 +194,37 @@ TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
   }
 }
 
+TEST_F(TransitionTraining, LeeEpisodesEndAtTheTerminationOutputWithPiBsOutcome) {
+  CompositeRecipe r = tiny();
+  StartStates starts = collect_start_states(r, 0, 4, 1);
+  LeeTransitionEnv env(r, 0, starts, 500);
+  ASSERT_EQ(env.spec().act_dim, 7);  // pi_b's 6 and the termination output
+  std::vector<float> obs(env.spec().obs_dim), act(7, 0.0f);
+  for (uint64_t seed = 0; seed < 4; ++seed) {
+    env.reset(seed, obs.data());
+    std::vector<double> state;
+    env.save_state(state);
+    // Two steps of pi_ab, then its termination output fires.
+    act[6] = -1.0f;
+    ASSERT_FALSE(env.step(act.data(), obs.data()).done());
+    ASSERT_FALSE(env.step(act.data(), obs.data()).done());
+    std::vector<double> at_end;
+    env.save_state(at_end);
+    act[6] = 1.0f;
+    StepResult sr = env.step(act.data(), obs.data());
+    EXPECT_TRUE(sr.terminated);
+    // The outcome is pi_b's, run from the state where pi_ab stopped.
+    auto task = r.make_env();
+    std::vector<float> full(r.spec.obs_dim);
+    task->restore_state(at_end, full.data());
+    EXPECT_EQ(sr.info.success, run_subtask(*task, r, r.meta.transitions()[0].to, full.data(), 500)) << seed;
+    auto episodes = env.take_finished();
+    ASSERT_EQ(episodes.size(), 1u);
+    EXPECT_EQ(episodes[0].states.size(), 3u * obs.size());  // s_0, s_1, s_2 = s_T
+    EXPECT_EQ(episodes[0].success, sr.info.success);
+  }
+}
+
 TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
   CompositeRecipe r = tiny();
   PipelineOptions o;
@@ -208,7 +240,8 @@ TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
   // Resumed: every stage finishes, each iteration logged once.
   stop = 0;
   EXPECT_EQ(run_pipeline(r, o), 0);
-  for (const char* f : {"start_states.pt", "demonstrations.pt", "policy.pt", "q.pt", "transition.csv", "switch.csv"})
+  for (const char* f : {"start_states.pt", "demonstrations.pt", "policy.pt", "q.pt", "lee.pt", "transition.csv",
+                        "switch.csv", "lee.csv", "actions.csv"})
     EXPECT_TRUE(fs::exists(t + f)) << f;
   std::ifstream csv(t + "transition.csv");
   int lines = 0;
@@ -216,7 +249,7 @@ TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
   EXPECT_EQ(lines, 1 + 4);  // header + 2048 / (4 x 128) iterations
   std::ifstream json(path("run/patrol.json"));
   std::string text((std::istreambuf_iterator<char>(json)), {});
-  for (const char* m : {"\"without-tp\"", "\"tp\"", "\"tp+q\""}) EXPECT_NE(text.find(m), std::string::npos) << m;
+  for (const char* m : {"\"without-tp\"", "\"tp\"", "\"tp+q\"", "\"lee\""}) EXPECT_NE(text.find(m), std::string::npos) << m;
   // A finished run skips its training stages: their outputs are left as they were.
   auto before = fs::last_write_time(t + "policy.pt"), q_before = fs::last_write_time(t + "q.pt");
   EXPECT_EQ(run_pipeline(r, o), 0);

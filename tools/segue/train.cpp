@@ -7,6 +7,7 @@
 
 #include "hrl/evaluation.h"
 #include "algorithms/skill_recipe.h"
+#include "core/assets.h"
 #include "core/progress.h"
 #include "core/run_dir.h"
 #include "tools/segue/cli.h"
@@ -49,6 +50,13 @@ int train_main(int argc, char** argv) {
   if (dir.has_checkpoint()) {
     ppo.load(dir.checkpoint());
     spdlog::info("resuming {} from iteration {} ({} steps)", dir.path(), ppo.iteration(), ppo.global_step());
+  } else if (!s.init_from.empty()) {
+    const std::string from = repo_path(s.init_from);
+    if (!std::filesystem::exists(from))
+      throw Error(recipe_path + ": key 'init_from': no such checkpoint '" + s.init_from + "'");
+    ppo.load(from);
+    spdlog::info("training {} in {} from {} (iteration {}, {} steps) to {} steps", s.task, dir.path(), s.init_from,
+                 ppo.iteration(), ppo.global_step(), s.ppo.total_steps);
   } else {
     spdlog::info("training {} in {} ({} steps, {} threads)", s.task, dir.path(), s.ppo.total_steps, threads);
   }

@@ -1,0 +1,174 @@
+#include "hrl/lee_transition.h"
+
+#include <algorithm>
+
+#include "hrl/switch_training.h"
+
+namespace segue {
+
+LeeTransitionEnv::LeeTransitionEnv(const CompositeRecipe& r, int transition, StartStates starts,
+                                   int max_subtask_steps)
+    : recipe_(r), to_(r.meta.transitions().at(transition).to),
+      inner_(r.make_env(), std::move(starts), r.meta.transitions()[transition].when, r.skills[to_].obs_begin,
+             r.skills[to_].obs_end),
+      max_subtask_steps_(max_subtask_steps) {
+  spec_ = inner_.spec();
+  spec_.name = r.spec.name + " (Lee transition)";
+  spec_.act_dim += 1;  // the termination output
+  spec_.act_low.push_back(-1.0f);
+  spec_.act_high.push_back(1.0f);
+}
+
+void LeeTransitionEnv::reset(uint64_t seed, float* obs) {
+  inner_.reset(seed, obs);
+  current_.states.assign(obs, obs + spec_.obs_dim);
+}
+
+void LeeTransitionEnv::reset(float* obs) {
+  inner_.reset(obs);
+  current_.states.assign(obs, obs + spec_.obs_dim);
+}
+
+void LeeTransitionEnv::restore_state(const std::vector<double>& state, float* obs) {
+  inner_.restore_state(state, obs);
+}
+
+StepResult LeeTransitionEnv::step(const float* action, float* obs) {
+  const int D = spec_.obs_dim;
+  StepResult r;
+  bool hand_over = action[spec_.act_dim - 1] > 0.0f;
+  if (hand_over) {
+    std::copy(current_.states.end() - D, current_.states.end(), obs);  // s_T: where pi_ab chose to end
+  } else {
+    r = inner_.step(action, obs);
+    current_.states.insert(current_.states.end(), obs, obs + D);
+    hand_over = r.truncated && !r.terminated;  // the interval ended: pi_b takes over
+  }
+  bool success = false;
+  if (hand_over) {
+    after_ = inner_.task_obs();  // pi_b runs on from here; obs keeps s_T
+    success = run_subtask(inner_.task(), recipe_, to_, after_.data(), max_subtask_steps_);
+  }
+  if (hand_over || r.terminated) {
+    r.terminated = true, r.truncated = false;
+    finished_.push_back({std::move(current_.states), success});
+    current_.states.clear();
+  }
+  r.info.success = success;
+  r.info.success_count = success;
+  r.reward = 0.0;  // replaced by the proximity reward
+  return r;
+}
+
+LeeTrainer::LeeTrainer(const TransitionPolicyConfig& tp, const LeeConfig& c, VectorEnv& envs,
+                       const Demonstrations& expert, const Policy& next, uint64_t seed)
+    : cfg_(c), envs_(envs),
+      ppo_(tp.ppo,
+           [&] {
+             ActorCriticSpec n = tp.net;
+             n.obs_dim = envs.spec().obs_dim, n.act_dim = envs.spec().act_dim;
+             return n;
+           }(),
+           envs, seed),
+      obs_dim_(envs.spec().obs_dim) {
+  if (expert.obs_dim != obs_dim_) throw Error("Lee transition policy: T_b's observation size differs from pi_b's");
+  if (tp.init_from_next) ppo_.init_actor(next, c.termination_bias);
+  torch::manual_seed(mix_seed(seed, 0x1ee));
+  ProximitySpec ps;
+  ps.obs_dim = obs_dim_;
+  ps.hidden = c.hidden;
+  ps.decay = c.decay;
+  p_ = ProximityPredictor(ps);
+  opt_ = std::make_unique<torch::optim::Adam>(p_->parameters(), torch::optim::AdamOptions(c.lr));
+  auto e = torch::from_blob(const_cast<float*>(expert.obs.data()), {int64_t(expert.size()), int64_t(obs_dim_)});
+  mean_ = e.mean(0);
+  std_ = e.std(0).clamp_min(1e-2);
+  for (int i = 0; i < expert.size(); ++i) add(&expert.obs[size_t(i) * obs_dim_], 1.0f);  // pi_b's own states
+  ppo_.set_reward_hook([this](RolloutBuffer& buf) { reward(buf); });
+}
+
+torch::Tensor LeeTrainer::normalize(const torch::Tensor& obs) const { return ((obs - mean_) / std_).clamp(-5.0, 5.0); }
+
+void LeeTrainer::add(const float* s, float label) {
+  const int64_t cap = cfg_.max_rows;
+  const bool positive = label > 0.0f;
+  auto& rows = positive ? pos_ : neg_;
+  int64_t& n = positive ? pos_n_ : neg_n_;
+  const int64_t row = n % cap;
+  if (n < cap) {
+    rows.resize(size_t(row + 1) * obs_dim_);
+    if (positive) pos_label_.push_back(0.0f);
+  }
+  std::copy(s, s + obs_dim_, rows.begin() + row * obs_dim_);
+  if (positive) pos_label_[row] = label;
+  ++n;
+}
+
+void LeeTrainer::reward(RolloutBuffer& buf) {
+  // 1. Label the finished episodes and fit P_b by least squares on both classes.
+  int episodes = 0, successes = 0;
+  for (int i = 0; i < envs_.size(); ++i)
+    for (auto& e : static_cast<LeeTransitionEnv&>(envs_.env(i)).take_finished()) {
+      const int T = int(e.states.size()) / obs_dim_;
+      std::vector<float> labels = proximity_labels(T, e.success, cfg_.decay);
+      for (int t = 0; t < T; ++t) add(&e.states[size_t(t) * obs_dim_], labels[t]);
+      ++episodes, successes += e.success;
+    }
+  last_ = Stats();
+  if (episodes) last_.handover_success = double(successes) / episodes;
+  const int64_t np = std::min<int64_t>(pos_n_, cfg_.max_rows), nn = std::min<int64_t>(neg_n_, cfg_.max_rows);
+  auto pos = torch::from_blob(pos_.data(), {np, int64_t(obs_dim_)});
+  auto pos_y = torch::from_blob(pos_label_.data(), {np});
+  auto neg = torch::from_blob(neg_.data(), {nn, int64_t(obs_dim_)});
+  for (int step = 0; step < cfg_.steps; ++step) {
+    auto pi = torch::randint(np, {cfg_.batch}, torch::kLong);
+    torch::Tensor x = normalize(pos.index_select(0, pi)), y = pos_y.index_select(0, pi);
+    if (nn > 0) {
+      auto ni = torch::randint(nn, {cfg_.batch}, torch::kLong);
+      x = torch::cat({x, normalize(neg.index_select(0, ni))});
+      y = torch::cat({y, torch::zeros({cfg_.batch})});
+    }
+    auto loss = p_->loss(x, y);
+    opt_->zero_grad();
+    loss.backward();
+    opt_->step();
+    last_.predictor_loss += loss.item<double>() / cfg_.steps;
+  }
+  // 2. Rewards P(s_{t+1}) - P(s_t), plus P(s_T) where the episode ends.
+  torch::NoGradGuard no_grad;
+  const int64_t M = int64_t(buf.T) * buf.N;
+  auto p0 = p_->forward(normalize(torch::from_blob(buf.raw_obs.data(), {M, int64_t(obs_dim_)})));
+  auto p1 = p_->forward(normalize(torch::from_blob(buf.next_raw_obs.data(), {M, int64_t(obs_dim_)})));
+  auto done = torch::from_blob(buf.dones.data(), {M}, torch::kUInt8).to(torch::kFloat32);
+  auto r = (p1 - p0 + done * p1).to(torch::kFloat64).contiguous();
+  std::copy(r.data_ptr<double>(), r.data_ptr<double>() + M, buf.raw_rewards.begin());
+}
+
+LeeTrainer::Stats LeeTrainer::iterate() {
+  IterationStats s = ppo_.iterate();
+  Stats out = last_;
+  out.ppo = s;
+  return out;
+}
+
+void LeeTrainer::save(const std::string& path, const std::string& note) const {
+  ppo_.save(path, note, [this](torch::serialize::OutputArchive& ar) {
+    torch::serialize::OutputArchive p, o;
+    p_->save(p);
+    opt_->save(o);
+    ar.write("proximity_predictor", p);
+    ar.write("proximity_optimizer", o);
+  });
+}
+
+void LeeTrainer::load(const std::string& path) {
+  ppo_.load(path, [this](torch::serialize::InputArchive& ar) {
+    torch::serialize::InputArchive p, o;
+    ar.read("proximity_predictor", p);
+    ar.read("proximity_optimizer", o);
+    p_->load(p);
+    opt_->load(o);
+  });
+}
+
+}  // namespace segue

@@ -1,0 +1,84 @@
+#pragma once
+// The baseline of Lee et al. 2019 ("Composing complex skills by learning transition
+// policies"): a transition policy rewarded by a proximity predictor P_b(s) in [0, 1], how
+// close s is to states from which pi_b succeeds, and ending itself with a termination
+// output. Per episode from a state of S_a:
+//   pi_ab acts until its extra output is positive (or the interval ends, or a fall);
+//   pi_b then runs its subtask; success labels the episode's states 0.95^k (k steps
+//   before the hand-over), failure labels them 0; pi_b's own states (T_b) are labelled 1.
+//   Rewards: P(s_{t+1}) - P(s_t), plus P(s_T) at the end (algorithms/proximity_predictor.h).
+#include <memory>
+#include <vector>
+
+#include "algorithms/ppo.h"
+#include "algorithms/proximity_predictor.h"
+#include "hrl/collection.h"
+#include "hrl/pipeline_config.h"
+#include "hrl/transition_env.h"
+
+namespace segue {
+
+// pi_ab's environment: pi_b's observation slice; pi_b's actions plus a termination output.
+// Every episode ends as a true end at the hand-over; info.success is pi_b's outcome.
+class LeeTransitionEnv : public Env {
+ public:
+  LeeTransitionEnv(const CompositeRecipe& recipe, int transition, StartStates starts, int max_subtask_steps);
+  const EnvSpec& spec() const override { return spec_; }
+  void reset(uint64_t seed, float* obs) override;
+  void reset(float* obs) override;
+  StepResult step(const float* action, float* obs) override;
+  void features(double* out) const override { inner_.features(out); }
+  void save_state(std::vector<double>& out) const override { inner_.save_state(out); }
+  void restore_state(const std::vector<double>& state, float* obs) override;
+
+  // Episodes finished since the last call: their states s_0..s_T (pi_b's slice) and outcome.
+  struct Episode {
+    std::vector<float> states;
+    bool success;
+  };
+  std::vector<Episode> take_finished() { return std::move(finished_); }
+
+ private:
+  const CompositeRecipe& recipe_;
+  int to_;
+  TransitionEnv inner_;  // S_a starts, pi_b's slice, the interval's end
+  int max_subtask_steps_;
+  EnvSpec spec_;
+  std::vector<float> after_;
+  Episode current_;
+  std::vector<Episode> finished_;
+};
+
+class LeeTrainer {
+ public:
+  // `envs` are LeeTransitionEnvs; `expert` is T_b (its states are P_b's label-1 data).
+  LeeTrainer(const TransitionPolicyConfig& tp, const LeeConfig& config, VectorEnv& envs,
+             const Demonstrations& expert, const Policy& next, uint64_t seed);
+  struct Stats {
+    IterationStats ppo;
+    double predictor_loss = 0, handover_success = NAN;
+  };
+  Stats iterate();
+  Policy policy() const { return ppo_.policy(); }
+  const PPO& ppo() const { return ppo_; }
+  void save(const std::string& path, const std::string& note) const;
+  void load(const std::string& path);
+
+ private:
+  void reward(RolloutBuffer& buf);  // PPO's reward hook
+  void add(const float* s, float label);
+  torch::Tensor normalize(const torch::Tensor& obs) const;
+
+  LeeConfig cfg_;
+  VectorEnv& envs_;
+  PPO ppo_;
+  ProximityPredictor p_{nullptr};
+  std::unique_ptr<torch::optim::Adam> opt_;
+  torch::Tensor mean_, std_;
+  int obs_dim_;
+  std::vector<float> pos_, pos_label_, neg_;  // labelled states: rings of max_rows
+  int64_t pos_n_ = 0, neg_n_ = 0;
+  Stats last_;
+};
+
+}  // namespace segue
