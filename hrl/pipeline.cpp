@@ -235,7 +235,15 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
     }
   }
   announce("evaluate every method");
-  for (int t = 0; t < n; ++t) write_actions(recipe, t, run + "/" + recipe.transition_name(t));
+  for (int t = 0; t < n; ++t) {
+    const std::string tdir = run + "/" + recipe.transition_name(t);
+    if (!exists(tdir + "/actions.csv")) write_actions(recipe, t, tdir);
+  }
+  const std::string table = run + "/" + recipe.task + ".json";
+  if (exists(table)) {
+    spdlog::info("  done already: {} (remove it to measure again)", table);
+    return 0;
+  }
   CompositeRecipe trained = recipe;
   trained.transitions_dir = fs::absolute(run).string();
   std::vector<std::pair<std::string, std::string>> skipped;

@@ -8,7 +8,8 @@
 //   4. lee         NAME/lee.pt (Lee et al.'s transition policy, TorchScript), NAME/lee.csv;
 //                  checkpoints to NAME/lee_checkpoint.pt (recipe key lee.enabled)
 // and finally
-//   5. evaluate    TASK.md / TASK.json: every method whose artefacts exist; NAME/actions.csv,
+//   5. evaluate    TASK.md / TASK.json: every method whose artefacts exist, 50 episodes x 3
+//                  seeds (the recipe's eval:), also written to --publish DIR; NAME/actions.csv,
 //                  the actions of pi_a, pi_ab and pi_b from the same S_a states through the
 //                  interval (paper Fig. 4: tools/tsne_actions.py draws it)
 // A stage whose outputs exist is skipped, so rerunning an interrupted run resumes it.

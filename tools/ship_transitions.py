@@ -1,0 +1,63 @@
+#!/usr/bin/env python3
+"""Ships the transition artefacts of a finished `segue run`: copies RUN_DIR/NAME/{policy,q,lee}.pt
+to assets/policies/<group>/<task>/NAME/ and records what each cost in manifest.json there
+(environment steps and wall time, read from the stage CSVs), and copies RUN_DIR/TASK.md/json
+to experiments/results/.
+
+usage: tools/ship_transitions.py RUN_DIR [--group walker] [--no-results]
+"""
+import argparse, csv, json, os, shutil, sys
+
+root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ap = argparse.ArgumentParser()
+ap.add_argument("run_dir")
+ap.add_argument("--group", default="walker")
+ap.add_argument("--no-results", action="store_true")
+args = ap.parse_args()
+
+
+def last_row(path):
+    if not os.path.exists(path):
+        return None
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+    return rows[-1] if rows else None
+
+
+recipe = open(os.path.join(args.run_dir, "recipe.yaml")).read()
+task = next(l.split(":", 1)[1].strip() for l in recipe.splitlines() if l.startswith("task:"))
+out_dir = os.path.join(root, "assets", "policies", args.group, task)
+manifest = {"task": task, "recipe": f"experiments/{task}.yaml", "transitions": {}}
+names = sorted(d for d in os.listdir(args.run_dir) if os.path.isfile(os.path.join(args.run_dir, d, "policy.pt")))
+if not names:
+    sys.exit(f"{args.run_dir}: no transition has a policy.pt; is the run finished?")
+for name in names:
+    src, dst = os.path.join(args.run_dir, name), os.path.join(out_dir, name)
+    os.makedirs(dst, exist_ok=True)
+    entry = {}
+    for f in ("policy.pt", "q.pt", "lee.pt"):
+        if os.path.exists(os.path.join(src, f)):
+            shutil.copyfile(os.path.join(src, f), os.path.join(dst, f))
+    for stage, csv_name, steps_key in (("transition", "transition.csv", "global_step"),
+                                       ("switch", "switch.csv", "env_steps"),
+                                       ("lee", "lee.csv", "global_step")):
+        row = last_row(os.path.join(src, csv_name))
+        if row:
+            entry[stage] = {"env_steps": int(float(row[steps_key])) if steps_key in row and row[steps_key] else None,
+                            "wall_seconds": round(float(row["wall_seconds"]), 1) if row.get("wall_seconds") else None}
+            if stage == "transition":
+                entry[stage]["interval_completed_last_iteration"] = float(row["interval_completed"])
+            if stage == "switch":
+                entry[stage]["attempts"] = int(float(row["attempts"]))
+                entry[stage]["subtask_success_last_100"] = float(row["subtask_success"])
+    manifest["transitions"][name] = entry
+with open(os.path.join(out_dir, "manifest.json"), "w") as f:
+    json.dump(manifest, f, indent=2, sort_keys=True)
+    f.write("\n")
+print(f"shipped {len(names)} transitions to {os.path.relpath(out_dir, root)}")
+if not args.no_results:
+    for ext in ("md", "json"):
+        src = os.path.join(args.run_dir, f"{task}.{ext}")
+        if os.path.exists(src):
+            shutil.copyfile(src, os.path.join(root, "experiments", "results", f"{task}.{ext}"))
+            print(f"copied {src} to experiments/results/")
