@@ -116,9 +116,15 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
     ++env_steps_;
     env_->features(features_.data());
     bool left = sr.truncated || !MetaController::holds(tr_.when, features_.data());
-    if (sr.terminated || left) {  // a fall, or the interval ran out while staying
+    if (sr.terminated) {  // a fall while staying
       store(full_.data(), a, cfg_.r_fail, next_full_.data(), true);
       return {false, t + 1};
+    }
+    if (left) {  // the interval ran out: the forced switch, valued by pi_b's outcome
+      std::copy(next_full_.begin(), next_full_.end(), scratch_.begin());
+      bool ok = run_subtask(*env_, recipe_, tr_.to, scratch_.data(), cfg_.max_subtask_steps, &env_steps_);
+      store(full_.data(), a, ok ? cfg_.r_success : cfg_.r_fail, next_full_.data(), true);
+      return {ok, t + 1};
     }
     store(full_.data(), a, 0.0, next_full_.data(), false);
     std::copy(next_full_.begin(), next_full_.begin() + D, full_.begin());

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 
 #include "core/assets.h"
 #include "environments/registry.h"
@@ -55,6 +56,26 @@ TEST(Shipped, CompositeRecipesLoadWithTheirSkills) {
     EvalResult e = evaluate(r.make_env, method_controllers(r, "without-tp"), 2, 0, 1);
     for (double ret : e.returns) EXPECT_TRUE(std::isfinite(ret)) << task;
   }
+}
+
+// Patrol's shipped transition policies and Q-networks drive every transition method, and
+// With TP reproduces its row of experiments/results/patrol.json on evaluation seed 0.
+TEST(Shipped, PatrolTransitionMethodsReproduceTheirTable) {
+  CompositeRecipe r = CompositeRecipe::load(CompositeRecipe::default_file("patrol"));
+  for (const std::string method : {"tp", "lee", "tp+q"}) {
+    EvalResult e = evaluate(r.make_env, method_controllers(r, method), 2, 0, 2);
+    for (double ret : e.returns) EXPECT_TRUE(std::isfinite(ret)) << method;
+  }
+  std::ifstream json(std::string(SEGUE_SOURCE_DIR) + "/experiments/results/patrol.json");
+  std::string text((std::istreambuf_iterator<char>(json)), {});
+  size_t at = text.find("\"tp\": {");
+  ASSERT_NE(at, std::string::npos);
+  at = text.find("\"per_seed_means\": [", at);
+  double seed0 = std::stod(text.substr(at + std::string("\"per_seed_means\": [").size()));
+  EvalResult e = evaluate(r.make_env, method_controllers(r, "tp"), r.eval_episodes, 0, 2);
+  double mean = 0;
+  for (double c : e.success_counts) mean += c / e.success_counts.size();
+  EXPECT_NEAR(mean, seed0, 1e-9);
 }
 
 TEST(Shipped, CompositeRecipeRefusesBadSkills) {
