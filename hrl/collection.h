@@ -13,7 +13,6 @@
 #include <vector>
 
 #include "hrl/composite_recipe.h"
-#include "hrl/transition_controller.h"
 
 namespace segue {
 
@@ -22,6 +21,10 @@ struct StartStates {
   std::vector<double> states;  // [N, state_dim], Env::save_state snapshots
   std::vector<float> obs;      // [N, obs_dim], the task observation there
   int size() const { return state_dim ? int(states.size() / state_dim) : 0; }
+  // Copies snapshot i into `out` (resized), ready for Env::restore_state.
+  void state(int i, std::vector<double>& out) const {
+    out.assign(states.begin() + size_t(i) * state_dim, states.begin() + size_t(i + 1) * state_dim);
+  }
 };
 
 struct Demonstrations {

@@ -49,39 +49,40 @@ const std::vector<std::string>& method_names() {
   return names;
 }
 
-namespace {
-
-// "Without TP": the meta-controller switches straight to the next skill as soon as the
-// transition interval begins.
-class WithoutTpController : public Controller {
- public:
-  WithoutTpController(const std::vector<Skill>& skills, const MetaController& meta)
-      : skills_(skills), meta_(meta) {}
-  void reset(const Env& env, const float*) override {
-    features_.resize(env.spec().feature_names.size());
-    env.features(features_.data());
-    skill_ = meta_.start_skill(features_.data());
+std::vector<TransitionArtefacts> load_transition_artefacts(const CompositeRecipe& r, const std::string& dir,
+                                                          const std::string& policy_file, bool with_q) {
+  std::vector<TransitionArtefacts> out(r.meta.transitions().size());
+  for (size_t t = 0; t < out.size(); ++t) {
+    const Skill& b = r.skills[r.meta.transitions()[t].to];
+    const std::string folder = dir + "/" + r.transition_name(int(t)) + "/";
+    if (std::filesystem::exists(folder + policy_file)) {
+      Policy p = Policy::load(folder + policy_file);
+      EnvSpec slice = r.spec;
+      slice.obs_dim = b.obs_end - b.obs_begin;
+      slice.act_dim = r.spec.act_dim + (policy_file == "lee.pt" ? 1 : 0);  // Lee's extra output: terminate
+      p.check_fits(slice, folder + policy_file);
+      out[t].policy = p;
+    }
+    if (with_q && std::filesystem::exists(folder + "q.pt")) {
+      Policy q = Policy::load(folder + "q.pt");
+      EnvSpec qs = r.spec;
+      qs.act_dim = 2;
+      q.check_fits(qs, folder + "q.pt");
+      out[t].q = q;
+    }
   }
-  void act(const Env& env, const float* obs, float* action) override {
-    env.features(features_.data());
-    int t = meta_.active_transition(skill_, features_.data());
-    if (t >= 0) skill_ = meta_.transitions()[t].to;
-    const Skill& s = skills_[skill_];
-    s.policy.act(obs + s.obs_begin, 1, action);
-  }
-
- private:
-  std::vector<Skill> skills_;  // own copies: Policy::act keeps scratch buffers
-  const MetaController& meta_;
-  std::vector<double> features_;
-  int skill_ = 0;
-};
-
-}  // namespace
+  return out;
+}
 
 ControllerFactory method_controllers(const CompositeRecipe& r, const std::string& method) {
-  if (method == "without-tp")
-    return [&r] { return std::make_unique<WithoutTpController>(r.skills, r.meta); };
+  if (method == "without-tp") {
+    // The meta-controller switches straight to the next skill as the interval begins:
+    // transition controllers with no transition policy trained.
+    std::vector<TransitionArtefacts> none(r.meta.transitions().size());
+    return [&r, none] {
+      return std::make_unique<TransitionController>(r.skills, r.meta, none, SwitchRule::IntervalEnd);
+    };
+  }
   if (method == "single") {
     if (r.single_policy.empty()) throw Error(r.file + ": key 'methods.single.policy' is not set");
     std::string path = repo_path(r.single_policy);
@@ -94,32 +95,16 @@ ControllerFactory method_controllers(const CompositeRecipe& r, const std::string
   if (method == "tp" || method == "tp+q" || method == "lee") {
     if (r.transitions_dir.empty())
       throw Error(r.file + ": key 'methods.transitions' is not set (a folder of trained transition policies)");
-    const std::string dir = repo_path(r.transitions_dir);
     const std::string file = method == "lee" ? "lee.pt" : "policy.pt";
-    std::vector<TransitionArtefacts> artefacts(r.meta.transitions().size());
+    std::vector<TransitionArtefacts> artefacts =
+        load_transition_artefacts(r, repo_path(r.transitions_dir), file, /*with_q=*/method == "tp+q");
     for (size_t t = 0; t < artefacts.size(); ++t) {
-      const Skill& b = r.skills[r.meta.transitions()[t].to];
-      std::string path = dir + "/" + r.transition_name(int(t)) + "/" + file;
-      if (!std::filesystem::exists(path))
-        throw Error(r.file + ": key 'methods.transitions': no " + file + " for transition " +
-                    r.transition_name(int(t)) + " in '" + r.transitions_dir + "' (train it with segue run)");
-      Policy p = Policy::load(path);
-      EnvSpec slice = r.spec;
-      slice.obs_dim = b.obs_end - b.obs_begin;
-      slice.act_dim = r.spec.act_dim + (method == "lee" ? 1 : 0);  // Lee's extra output: terminate
-      p.check_fits(slice, path);
-      artefacts[t].policy = p;
-      if (method == "tp+q") {
-        std::string q = dir + "/" + r.transition_name(int(t)) + "/q.pt";
-        if (!std::filesystem::exists(q))
-          throw Error(r.file + ": key 'methods.transitions': no q.pt for transition " + r.transition_name(int(t)) +
-                      " in '" + r.transitions_dir + "' (train it with segue run)");
-        Policy qp = Policy::load(q);
-        EnvSpec qs = r.spec;
-        qs.act_dim = 2;
-        qp.check_fits(qs, q);
-        artefacts[t].q = qp;
-      }
+      auto missing = [&](const std::string& f) {
+        return Error(r.file + ": key 'methods.transitions': no " + f + " for transition " +
+                     r.transition_name(int(t)) + " in '" + r.transitions_dir + "' (train it with segue run)");
+      };
+      if (!artefacts[t].policy) throw missing(file);
+      if (method == "tp+q" && !artefacts[t].q) throw missing("q.pt");
     }
     SwitchRule rule = method == "tp" ? SwitchRule::IntervalEnd
                       : method == "tp+q" ? SwitchRule::QNetwork

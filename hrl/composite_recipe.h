@@ -24,6 +24,7 @@
 #include "hrl/evaluation.h"
 #include "hrl/meta_controller.h"
 #include "hrl/pipeline_config.h"
+#include "hrl/transition_controller.h"
 #include "hrl/skill.h"
 
 namespace segue {
@@ -52,6 +53,10 @@ struct CompositeRecipe {
 
 // Method names from the paper: single, without-tp, tp, lee, tp+q.
 const std::vector<std::string>& method_names();
+// The transition artefacts in DIR/NAME/ for each transition: `policy_file` (policy.pt, or
+// lee.pt for Lee et al.'s) and, with_q, q.pt, where they exist, checked to fit the task.
+std::vector<TransitionArtefacts> load_transition_artefacts(const CompositeRecipe& recipe, const std::string& dir,
+                                                          const std::string& policy_file, bool with_q);
 // Controllers for `method` on this recipe; throws segue::Error when the method's
 // artefacts are not available.
 ControllerFactory method_controllers(const CompositeRecipe& recipe, const std::string& method);

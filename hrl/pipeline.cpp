@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
+#include <functional>
 #include <sstream>
 
 #include "core/progress.h"
@@ -20,22 +21,11 @@ namespace fs = std::filesystem;
 
 bool exists(const std::string& path) { return fs::exists(path); }
 
-// The transition policies and Q-networks trained so far in this run.
-std::vector<TransitionArtefacts> trained_so_far(const CompositeRecipe& r, const std::string& run) {
-  std::vector<TransitionArtefacts> out(r.meta.transitions().size());
-  for (size_t t = 0; t < out.size(); ++t) {
-    std::string dir = run + "/" + r.transition_name(int(t));
-    if (exists(dir + "/policy.pt")) out[t].policy = Policy::load(dir + "/policy.pt");
-    if (exists(dir + "/q.pt")) out[t].q = Policy::load(dir + "/q.pt");
-  }
-  return out;
-}
-
 void collect(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir) {
   const CollectConfig& c = r.pipeline.collect;
   if (!exists(dir + "/start_states.pt")) {
     spdlog::info("  collecting S_a: {} states where pi_a enters the interval", c.start_states);
-    save(collect_start_states(r, t, c.start_states, mix_seed(r.pipeline.seed, 2 * t), trained_so_far(r, run)),
+    save(collect_start_states(r, t, c.start_states, mix_seed(r.pipeline.seed, 2 * t), load_transition_artefacts(r, run, "policy.pt", /*with_q=*/true)),
          dir + "/start_states.pt");
   }
   if (!exists(dir + "/demonstrations.pt")) {
@@ -181,8 +171,7 @@ void write_actions(const CompositeRecipe& r, int t, const std::string& dir, int 
                              {lb.c_str(), &b.policy, b.obs_begin}};
   for (const Driver& d : drivers)
     for (int i = 0; i < std::min(starts_used, starts.size()); ++i) {
-      state.assign(starts.states.begin() + size_t(i) * starts.state_dim,
-                   starts.states.begin() + size_t(i + 1) * starts.state_dim);
+      starts.state(i, state);
       env->restore_state(state, obs.data());
       for (int step = 0; step < 1000; ++step) {
         d.policy->act(obs.data() + d.begin, 1, act.data());
@@ -212,27 +201,28 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
     fs::create_directories(tdir);
     announce(name + ": collect S_a and T_b");
     collect(recipe, t, run, tdir);
-    announce(name + ": transition policy (AIRL, Algorithm 1)");
-    if (exists(tdir + "/policy.pt")) {
-      spdlog::info("  done already: {}/policy.pt", tdir);
-    } else if (int stop = train_transition(recipe, t, tdir, o)) {
-      spdlog::warn("interrupted: checkpoint saved; rerun the same command to resume");
+    // Runs a training stage unless its output exists; the signal number if it was stopped.
+    auto stage_unless_done = [&](const std::string& output, const std::function<int()>& train) {
+      if (exists(output)) {
+        spdlog::info("  done already: {}", output);
+        return 0;
+      }
+      int stop = train();
+      if (stop) spdlog::warn("interrupted: checkpoint saved; rerun the same command to resume");
       return stop;
-    }
+    };
+    announce(name + ": transition policy (AIRL, Algorithm 1)");
+    if (int stop = stage_unless_done(tdir + "/policy.pt", [&] { return train_transition(recipe, t, tdir, o); }))
+      return stop;
     announce(name + ": switch Q-network (double DQN, Algorithm 2)");
-    if (exists(tdir + "/q.pt"))
-      spdlog::info("  done already: {}/q.pt", tdir);
-    else
+    stage_unless_done(tdir + "/q.pt", [&] {
       train_switch(recipe, t, tdir);
+      return 0;
+    });
     if (o.stop && o.stop->load()) return o.stop->load();
     if (!lee) continue;
     announce(name + ": Lee et al. 2019 baseline (proximity reward, termination head)");
-    if (exists(tdir + "/lee.pt")) {
-      spdlog::info("  done already: {}/lee.pt", tdir);
-    } else if (int stop = train_lee(recipe, t, tdir, o)) {
-      spdlog::warn("interrupted: checkpoint saved; rerun the same command to resume");
-      return stop;
-    }
+    if (int stop = stage_unless_done(tdir + "/lee.pt", [&] { return train_lee(recipe, t, tdir, o); })) return stop;
   }
   announce("evaluate every method");
   for (int t = 0; t < n; ++t) {

@@ -48,8 +48,7 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
   int64_t rows = 0, steps = 0;
   const int probes = std::min(20, starts_.size());
   for (int p = 0; p < probes; ++p) {
-    state_.assign(starts_.states.begin() + size_t(p) * starts_.state_dim,
-                  starts_.states.begin() + size_t(p + 1) * starts_.state_dim);
+    starts_.state(p, state_);
     env_->restore_state(state_, full_.data());
     for (int t = 0; t < 100000; ++t) {
       for (int j = 0; j < D; ++j) sum[j] += full_[j], sq[j] += double(full_[j]) * full_[j];
@@ -71,9 +70,12 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
   q_copy_ = EigenMlp(q_->q, Activation::Relu);
 }
 
+void SwitchTrainer::normalize(const float* in, float* out) const {
+  for (size_t j = 0; j < mean_.size(); ++j) out[j] = std::clamp((in[j] - mean_[j]) * inv_std_[j], -5.0f, 5.0f);
+}
+
 int SwitchTrainer::greedy(const float* obs) {
-  const int D = int(full_.size());
-  for (int j = 0; j < D; ++j) scratch_[j] = std::clamp((obs[j] - mean_[j]) * inv_std_[j], -5.0f, 5.0f);
+  normalize(obs, scratch_.data());
   q_copy_.forward(scratch_.data(), 1, qvals_.data());
   return qvals_[SwitchQNetworkImpl::kSwitch] > qvals_[SwitchQNetworkImpl::kStay] ? SwitchQNetworkImpl::kSwitch
                                                                                  : SwitchQNetworkImpl::kStay;
@@ -86,10 +88,8 @@ void SwitchTrainer::store(const float* s, int a, double r, const float* s2, bool
     obs_.resize(size_t(row + 1) * D), next_obs_.resize(size_t(row + 1) * D);
     action_.push_back(0), reward_.push_back(0), done_.push_back(0);
   }
-  for (int j = 0; j < D; ++j) {
-    obs_[row * D + j] = std::clamp((s[j] - mean_[j]) * inv_std_[j], -5.0f, 5.0f);
-    next_obs_[row * D + j] = std::clamp((s2[j] - mean_[j]) * inv_std_[j], -5.0f, 5.0f);
-  }
+  normalize(s, &obs_[row * D]);
+  normalize(s2, &next_obs_[row * D]);
   action_[row] = a, reward_[row] = float(r), done_[row] = done ? 1.0f : 0.0f;
   ++stored_;
 }
@@ -99,8 +99,7 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
   const Skill& b = recipe_.skills[tr_.to];
   std::vector<float> act(env_->spec().act_dim);
   int i = rng_.integer(0, starts_.size() - 1);
-  state_.assign(starts_.states.begin() + size_t(i) * starts_.state_dim,
-                starts_.states.begin() + size_t(i + 1) * starts_.state_dim);
+  starts_.state(i, state_);
   env_->restore_state(state_, full_.data());
   const int switch_at = random ? rng_.integer(0, interval_length_ - 1) : -1;
   for (int t = 0;; ++t) {

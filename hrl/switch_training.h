@@ -59,6 +59,8 @@ class SwitchTrainer {
   void store(const float* s, int a, double r, const float* s2, bool done);
   double update();
   int greedy(const float* obs);
+  // q_ab's input: (s - mean) / std from the probe, clipped to +-5 (as q_function() exports).
+  void normalize(const float* in, float* out) const;
 
   SwitchConfig cfg_;
   const CompositeRecipe& recipe_;

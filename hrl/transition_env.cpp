@@ -14,7 +14,6 @@ TransitionEnv::TransitionEnv(std::unique_ptr<Env> task, StartStates starts, std:
   spec_.obs_dim = end_ - begin_;
   full_.resize(task_->spec().obs_dim);
   features_.resize(task_->spec().feature_names.size());
-  state_.resize(starts_.state_dim);
 }
 
 void TransitionEnv::slice(float* obs) const { std::copy(full_.begin() + begin_, full_.begin() + end_, obs); }
@@ -26,8 +25,7 @@ void TransitionEnv::reset(uint64_t seed, float* obs) {
 
 void TransitionEnv::reset(float* obs) {
   int i = rng_.integer(0, starts_.size() - 1);
-  std::copy(starts_.states.begin() + size_t(i) * starts_.state_dim,
-            starts_.states.begin() + size_t(i + 1) * starts_.state_dim, state_.begin());
+  starts_.state(i, state_);
   task_->restore_state(state_, full_.data());
   slice(obs);
 }

@@ -26,7 +26,8 @@ TEST(Collection, StartStatesAreAtTheIntervalAndReplayPiA) {
   std::vector<float> oa(s.obs_dim), ob(s.obs_dim), act(6);
   std::vector<double> f(a->spec().feature_names.size());
   for (int i = 0; i < s.size(); ++i) {
-    std::vector<double> state(s.states.begin() + i * s.state_dim, s.states.begin() + (i + 1) * s.state_dim);
+    std::vector<double> state;
+    s.state(i, state);
     a->restore_state(state, oa.data());
     ASSERT_EQ(oa, std::vector<float>(s.obs.begin() + i * s.obs_dim, s.obs.begin() + (i + 1) * s.obs_dim));
     a->features(f.data());
