@@ -55,6 +55,12 @@ int64_t PPO::total_iterations() const {
   return (cfg_.total_steps + cfg_.rollout_size() - 1) / cfg_.rollout_size();
 }
 
+void PPO::set_log_std(double log_std) {
+  torch::NoGradGuard no_grad;
+  net_->log_std.fill_(log_std);
+  refresh_inference_copy();
+}
+
 void PPO::refresh_inference_copy() {
   actor_copy_ = EigenMlp(net_->actor, net_->spec.activation);
   auto ls = net_->log_std.detach().contiguous();

@@ -82,6 +82,9 @@ class PPO {
   // is trained to match. The actor may have more outputs than the policy (Lee et al.'s
   // termination head): those start at zero weight and bias `extra_bias`.
   void init_actor(const Policy& policy, float extra_bias = 0.0f);
+  // Sets every action dimension's log std: a run continued from a converged checkpoint
+  // has next to no exploration left (PPO here has no entropy bonus).
+  void set_log_std(double log_std);
 
   // Checkpoint: network, optimiser, normalisers, counters and `note` (the resolved
   // recipe), written atomically. `extra` adds an owner's state (a discriminator) to the

@@ -13,6 +13,9 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   s.run_dir = root.get("run_dir", default_run_dir);
   s.checkpoint_every = root.get("checkpoint_every", s.checkpoint_every);
   s.init_from = root.get<std::string>("init_from", "");
+  s.init_log_std = root.get("init_log_std", s.init_log_std);
+  if (!std::isnan(s.init_log_std) && s.init_from.empty())
+    throw root.error("init_log_std", "applies to a run that starts from init_from");
   try {
     s.make_env = task_factory(s.task, root.sub("env"));
   } catch (const Error& e) {

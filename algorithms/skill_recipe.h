@@ -7,6 +7,7 @@
 //   run_dir: runs/walker_forward
 //   checkpoint_every: 5       # iterations
 //   init_from: runs/walker_jump/checkpoint.pt   # optional: continue an earlier run
+//   init_log_std: -1.0        # optional, with init_from: reset the policy's log std
 //   env: {...}                # the task's settings (reference defaults)
 //   policy: {pi_hidden: [32, 32], vf_hidden: [32, 32], activation: tanh, init_log_std: -0.5}
 //   ppo: {...}                # see PpoConfig
@@ -15,6 +16,7 @@
 // eval.reference_task: judge the trained skill on the task with every env key at its
 // reference value (a recipe may train on an easier or reshaped version, e.g. a curb
 // curriculum, and must still be measured on the spec's task).
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <string>
@@ -34,6 +36,7 @@ struct SkillRecipe {
   // a later training stage, e.g. a harder curriculum, continues an earlier run's
   // budget. "" = from scratch.
   std::string init_from;
+  double init_log_std = NAN;  // with init_from: the log std to restart exploration at (NaN: keep)
   int checkpoint_every = 5;
   int eval_episodes = 50;
   uint64_t eval_seed = 1000;

@@ -41,6 +41,13 @@ Factory walker_jump(const std::string& name, const Section& env) {
   j.curb_height_min = env.get("curb_height_min", j.curb_height);
   if (j.curb_height_min > j.curb_height || j.curb_height_min <= 0)
     throw env.error("curb_height_min", "must be in (0, curb_height]");
+  j.curbs = env.get("curbs", j.curbs);
+  j.curb_spacing = env.get("curb_spacing", j.curb_spacing);
+  j.clearance_weight = env.get("clearance_weight", j.clearance_weight);
+  j.clearance_before = env.get("clearance_before", j.clearance_before);
+  if (j.curbs < 1) throw env.error("curbs", "must be at least 1");
+  if (j.curbs > 1 && j.curb_spacing <= 2 * j.curb_noise + o.curb_width)
+    throw env.error("curb_spacing", "must exceed 2 curb_noise + curb_width so curbs do not overlap");
   return [=] { return std::make_unique<WalkerJump>(name, w, o, j); };
 }
 
@@ -52,6 +59,8 @@ Factory walker_crawl(const std::string& name, const Section& env) {
   WalkerCrawl::Config c;
   c.ceiling_start = env.get("ceiling_start", c.ceiling_start);
   c.ceiling_end = env.get("ceiling_end", c.ceiling_end);
+  c.crouch_weight = env.get("crouch_weight", c.crouch_weight);
+  c.crouch_height = env.get("crouch_height", c.crouch_height);
   return [=] { return std::make_unique<WalkerCrawl>(name, w, o, c); };
 }
 

@@ -143,45 +143,64 @@ WalkerJump::WalkerJump(const std::string& name, const WalkerConfig& w, const Obs
     : WalkerObstacleEnv(name, w, o, true), jcfg_(c) {}
 
 void WalkerJump::reset_task() {
-  double start = jcfg_.curb_x + rng_.symmetric(jcfg_.curb_noise);
-  set_obstacles({{ObstacleKind::Curb, start, start + ocfg_.curb_width}});
-  height_ = rng_.uniform(jcfg_.curb_height_min, jcfg_.curb_height);
-  set_curb_height(0, height_);
+  std::vector<Obstacle> layout;
+  heights_.clear();
+  for (int k = 0; k < jcfg_.curbs; ++k) {
+    double start = jcfg_.curb_x + k * jcfg_.curb_spacing + rng_.symmetric(jcfg_.curb_noise);
+    layout.push_back({ObstacleKind::Curb, start, start + ocfg_.curb_width});
+    heights_.push_back(rng_.uniform(jcfg_.curb_height_min, jcfg_.curb_height));
+  }
+  set_obstacles(layout);
+  for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
   crossed_ = 0;
   WalkerEnv::reset_task();
 }
 
+double WalkerJump::clearance(int foot, double height) const {
+  return std::clamp((data_->xpos[3 * foot + 2] - kFootRadius) / height, 0.0, 1.0);
+}
+
 StepResult WalkerJump::evaluate(const float* action) {
   StepResult r;
-  const Obstacle& curb = obstacles_[0];
   double v = x_velocity();
   r.reward = walk_reward(v, action, 2.0, 2.0);
-  // Bonuses for the trailing foot crossing the curb's start, centre and end.
-  const double marks[3] = {curb.start, 0.5 * (curb.start + curb.end), curb.end};
-  while (crossed_ < 3 && trailing_foot_x() > marks[crossed_]) {
+  // Bonuses for the trailing foot crossing each curb's start, centre and end.
+  const int marks = 3 * int(obstacles_.size());
+  while (crossed_ < marks) {
+    const Obstacle& c = obstacles_[crossed_ / 3];
+    const double at[3] = {c.start, 0.5 * (c.start + c.end), c.end};
+    if (trailing_foot_x() <= at[crossed_ % 3]) break;
     r.reward += jcfg_.cross_bonus;
     ++crossed_;
   }
   double x = min_x();
-  if (x > curb.start - 1.0 && x < curb.end) r.reward += jcfg_.upward_weight * std::max(z_velocity(), 0.0);
+  int next = next_obstacle();
+  if (next >= 0) {
+    const Obstacle& curb = obstacles_[next];
+    if (x > curb.start - 1.0 && x < curb.end) r.reward += jcfg_.upward_weight * std::max(z_velocity(), 0.0);
+    if (jcfg_.clearance_weight > 0 && x > curb.start - jcfg_.clearance_before && x < curb.end)
+      r.reward += jcfg_.clearance_weight *
+                  std::min(clearance(foot_, heights_[next]), clearance(foot_left_, heights_[next]));
+  }
   bool contact = touching();
   if (contact) r.reward -= ocfg_.contact_penalty;
   update_passed();
-  r.info.success = passed_ > 0;
+  r.info.success = passed_ == int(obstacles_.size());
   r.info.success_count = passed_;
   r.info.metrics[0] = v;
-  r.terminated = fallen() || contact || x > jcfg_.end_x;
+  r.terminated = fallen() || contact || x > jcfg_.end_x + (jcfg_.curbs - 1) * jcfg_.curb_spacing;
   return r;
 }
 
 void WalkerJump::save_extra(std::vector<double>& out) const {
   out.push_back(crossed_);
-  out.push_back(height_);
+  out.insert(out.end(), heights_.begin(), heights_.end());
 }
 void WalkerJump::restore_extra(const double* in, size_t n) {
   crossed_ = n > 0 ? int(in[0]) : 0;
-  height_ = n > 1 ? in[1] : jcfg_.curb_height;
-  set_curb_height(0, height_);
+  heights_.assign(obstacles_.size(), jcfg_.curb_height);
+  for (size_t k = 0; k + 1 < n && k < heights_.size(); ++k) heights_[k] = in[1 + k];
+  for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
 }
 
 // ---- crawl -----------------------------------------------------------------------------
@@ -196,6 +215,7 @@ void WalkerCrawl::reset_task() {
 
 StepResult WalkerCrawl::evaluate(const float* action) {
   double reward = walk_reward(x_velocity(), action, 2.0, 0.0);  // no height term: crawling is low
+  reward -= ccfg_.crouch_weight * std::abs(torso_z() - ccfg_.crouch_height);
   bool contact = touching();
   if (contact) reward -= ocfg_.contact_penalty;
   return survival_step(reward, fallen() || contact);

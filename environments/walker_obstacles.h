@@ -70,7 +70,8 @@ class WalkerObstacleEnv : public WalkerEnv {
   std::vector<uint8_t> geom_kind_;                // ObstacleKind per geom, 0 for the rest
 };
 
-// Jump: one curb at curb_x + U(curb_noise); pass it without touching it.
+// Jump: one curb at curb_x + U(curb_noise); pass it without touching it. Training may
+// lay out several curbs, curb_spacing apart, so an episode holds several jump attempts.
 class WalkerJump : public WalkerObstacleEnv {
  public:
   struct Config {
@@ -82,6 +83,12 @@ class WalkerJump : public WalkerObstacleEnv {
     // the 0.4 m curb; a lower minimum is a curriculum that lets training find jumping
     // by first stepping over low curbs (a policy only ever meeting 0.4 m runs into it).
     double curb_height = 0.4, curb_height_min = 0.4;
+    int curbs = 1;               // the task has one; more give more attempts per episode
+    double curb_spacing = 8.0;   // nominal distance between successive curbs' starts
+    // + clearance_weight min over both feet of min(1, foot clearance / curb height) while
+    // the walker is over or up to clearance_before before the next curb: both feet off the
+    // ground together is a jump, which the crossing bonuses pay only once it succeeds.
+    double clearance_weight = 0.0, clearance_before = 0.3;
   };
   WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
 
@@ -92,9 +99,14 @@ class WalkerJump : public WalkerObstacleEnv {
   void restore_extra(const double* in, size_t n) override;
 
  private:
+  static constexpr double kFootRadius = 0.06;  // walker_base.xml's foot capsules
+  // How far the bottom of `foot` (a body id) is above the ground, as a fraction of the
+  // curb's height, in [0, 1].
+  double clearance(int foot, double height) const;
+
   Config jcfg_;
-  int crossed_ = 0;  // how many of start, centre, end the trailing foot has crossed
-  double height_ = 0.4;
+  int crossed_ = 0;              // marks (start, centre, end of each curb) the trailing foot has crossed
+  std::vector<double> heights_;  // per curb
 };
 
 // Crawl: survive under a long ceiling (x from ceiling_start to ceiling_end).
@@ -102,6 +114,10 @@ class WalkerCrawl : public WalkerObstacleEnv {
  public:
   struct Config {
     double ceiling_start = 2.0, ceiling_end = 14.0;
+    // - crouch_weight |torso z - crouch_height|: the reference has no height term, and
+    // without one PPO finds diving flat and dragging itself along (the torso then sits at
+    // the 0.3 m fall line: 30% success after 16M steps). 0 = the reference reward.
+    double crouch_weight = 0.0, crouch_height = 0.6;
   };
   WalkerCrawl(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
 

@@ -43,6 +43,7 @@ class LeeTransitionEnv : public Env {
   int to_;
   TransitionEnv inner_;  // S_a starts, pi_b's slice, the interval's end
   int max_subtask_steps_;
+  TransitionController pi_b_;  // pi_b alone judges a hand-over, as in Lee et al.
   EnvSpec spec_;
   std::vector<float> after_;
   Episode current_;

@@ -25,7 +25,8 @@ void collect(const CompositeRecipe& r, int t, const std::string& run, const std:
   const CollectConfig& c = r.pipeline.collect;
   if (!exists(dir + "/start_states.pt")) {
     spdlog::info("  collecting S_a: {} states where pi_a enters the interval", c.start_states);
-    save(collect_start_states(r, t, c.start_states, mix_seed(r.pipeline.seed, 2 * t), load_transition_artefacts(r, run, "policy.pt", /*with_q=*/true)),
+    save(collect_start_states(r, t, c.start_states, mix_seed(r.pipeline.seed, 2 * t),
+                              load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false)),
          dir + "/start_states.pt");
   }
   if (!exists(dir + "/demonstrations.pt")) {
@@ -124,9 +125,10 @@ int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const Pip
   return stop;
 }
 
-void train_switch(const CompositeRecipe& r, int t, const std::string& dir) {
+void train_switch(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir) {
   const SwitchConfig& cfg = r.pipeline.switching;
   SwitchTrainer trainer(cfg, r, t, load_start_states(dir + "/start_states.pt"), Policy::load(dir + "/policy.pt"),
+                        load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false),
                         mix_seed(r.pipeline.seed, 200 + t));
   MetricsCsv csv(dir + "/switch.csv", {"attempts", "epsilon", "subtask_success", "switch_step", "loss", "env_steps", "wall_seconds"}, 0);
   const int chunk = 100;
@@ -196,39 +198,43 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
   const int stages = (lee ? 4 : 3) * n + 1;
   int stage = 0;
   auto announce = [&](const std::string& what) { spdlog::info("[stage {}/{}] {}", ++stage, stages, what); };
+  // Runs a training stage unless its output exists; the signal number if it was stopped.
+  auto stage_unless_done = [&](const std::string& output, const std::function<int()>& train) {
+    if (exists(output)) {
+      spdlog::info("  done already: {}", output);
+      return 0;
+    }
+    int stop = train();
+    if (stop) spdlog::warn("interrupted: checkpoint saved; rerun the same command to resume");
+    return stop;
+  };
+  auto tdir = [&](int t) { return run + "/" + recipe.transition_name(t); };
+  // Every pi_ab first: S_a of a later transition is collected With TP through the earlier
+  // ones, and switch training may carry episodes on through any of them (lookahead).
   for (int t = 0; t < n; ++t) {
-    const std::string name = recipe.transition_name(t), tdir = run + "/" + name;
-    fs::create_directories(tdir);
-    announce(name + ": collect S_a and T_b");
-    collect(recipe, t, run, tdir);
-    // Runs a training stage unless its output exists; the signal number if it was stopped.
-    auto stage_unless_done = [&](const std::string& output, const std::function<int()>& train) {
-      if (exists(output)) {
-        spdlog::info("  done already: {}", output);
-        return 0;
-      }
-      int stop = train();
-      if (stop) spdlog::warn("interrupted: checkpoint saved; rerun the same command to resume");
+    fs::create_directories(tdir(t));
+    announce(recipe.transition_name(t) + ": collect S_a and T_b");
+    collect(recipe, t, run, tdir(t));
+    announce(recipe.transition_name(t) + ": transition policy (AIRL, Algorithm 1)");
+    if (int stop = stage_unless_done(tdir(t) + "/policy.pt", [&] { return train_transition(recipe, t, tdir(t), o); }))
       return stop;
-    };
-    announce(name + ": transition policy (AIRL, Algorithm 1)");
-    if (int stop = stage_unless_done(tdir + "/policy.pt", [&] { return train_transition(recipe, t, tdir, o); }))
-      return stop;
-    announce(name + ": switch Q-network (double DQN, Algorithm 2)");
-    stage_unless_done(tdir + "/q.pt", [&] {
-      train_switch(recipe, t, tdir);
+  }
+  for (int t = 0; t < n; ++t) {
+    announce(recipe.transition_name(t) + ": switch Q-network (double DQN, Algorithm 2)");
+    stage_unless_done(tdir(t) + "/q.pt", [&] {
+      train_switch(recipe, t, run, tdir(t));
       return 0;
     });
     if (o.stop && o.stop->load()) return o.stop->load();
-    if (!lee) continue;
-    announce(name + ": Lee et al. 2019 baseline (proximity reward, termination head)");
-    if (int stop = stage_unless_done(tdir + "/lee.pt", [&] { return train_lee(recipe, t, tdir, o); })) return stop;
+  }
+  for (int t = 0; t < n && lee; ++t) {
+    announce(recipe.transition_name(t) + ": Lee et al. 2019 baseline (proximity reward, termination head)");
+    if (int stop = stage_unless_done(tdir(t) + "/lee.pt", [&] { return train_lee(recipe, t, tdir(t), o); }))
+      return stop;
   }
   announce("evaluate every method");
-  for (int t = 0; t < n; ++t) {
-    const std::string tdir = run + "/" + recipe.transition_name(t);
-    if (!exists(tdir + "/actions.csv")) write_actions(recipe, t, tdir);
-  }
+  for (int t = 0; t < n; ++t)
+    if (!exists(tdir(t) + "/actions.csv")) write_actions(recipe, t, tdir(t));
   const std::string table = run + "/" + recipe.task + ".json";
   if (exists(table)) {
     spdlog::info("  done already: {} (remove it to measure again)", table);

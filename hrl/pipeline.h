@@ -1,6 +1,7 @@
 #pragma once
 // `segue run RECIPE`: Algorithms 1 and 2 for every transition of a composite task, then
-// the results table. Per transition NAME ("walk-jump"), in the run directory:
+// the results table. Stages 1-2 run for every transition, then 3 for every one, then 4.
+// Per transition NAME ("walk-jump"), in the run directory:
 //   1. collect     NAME/start_states.pt (S_a), NAME/demonstrations.pt (T_b)
 //   2. transition  NAME/policy.pt (pi_ab, TorchScript), NAME/transition.csv; training
 //                  checkpoints to NAME/transition_checkpoint.pt and resumes from it

@@ -54,6 +54,8 @@ SwitchConfig SwitchConfig::read(const Section& s) {
   c.epsilon_end = s.get("epsilon_end", c.epsilon_end);
   c.explore_fraction = s.get("explore_fraction", c.explore_fraction);
   c.max_subtask_steps = s.get("max_subtask_steps", c.max_subtask_steps);
+  c.lookahead = s.get("lookahead", c.lookahead);
+  if (c.lookahead < 1) throw s.error("lookahead", "must be at least 1");
   if (c.batch <= 0) throw s.error("batch", "must be positive");
   if (c.replay < c.batch) throw s.error("replay", "must hold at least one batch");
   if (c.target_every <= 0) throw s.error("target_every", "must be positive");

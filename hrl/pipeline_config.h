@@ -62,6 +62,10 @@ struct SwitchConfig {
   // the interval (reference). It decays linearly to epsilon_end over explore_fraction.
   double epsilon_start = 1.0, epsilon_end = 0.1, explore_fraction = 0.5;
   int max_subtask_steps = 3000;  // pi_b's run is cut (and counted a success) after this
+  // How many transition intervals must begin after a hand-over for it to count as r_s
+  // (run_subtask): 1 is the paper's (pi_b reaches its own end); 2 also asks that the
+  // episode, carried on With TP, gets through the next skill.
+  int lookahead = 1;
 
   static SwitchConfig read(const Section& s);
 };

@@ -6,26 +6,29 @@
 
 namespace segue {
 
-bool run_subtask(Env& env, const CompositeRecipe& r, int to, float* obs, int max_steps, int64_t* steps) {
-  const Skill& b = r.skills[to];
+bool run_subtask(Env& env, const CompositeRecipe& r, TransitionController& after, int to, float* obs,
+                 int lookahead, int max_steps, int64_t* steps) {
   std::vector<float> act(env.spec().act_dim);
-  std::vector<double> f(env.spec().feature_names.size());
+  after.resume(env, to);
+  int begun = 0;
   for (int step = 0; step < max_steps; ++step) {
-    b.policy.act(obs + b.obs_begin, 1, act.data());
+    int skill = after.skill();
+    after.act(env, obs, act.data());
+    if (after.skill() != skill && ++begun == lookahead) return true;  // a transition began
     StepResult sr = env.step(act.data(), obs);
     if (steps) ++*steps;
     if (sr.terminated) return false;
     if (sr.truncated) return true;
-    env.features(f.data());
-    if (r.meta.active_transition(to, f.data()) >= 0) return true;
   }
   return true;
 }
 
 SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& recipe, int transition,
-                             StartStates starts, Policy pi_ab, uint64_t seed)
+                             StartStates starts, Policy pi_ab, std::vector<TransitionArtefacts> trained,
+                             uint64_t seed)
     : cfg_(config), recipe_(recipe), tr_(recipe.meta.transitions().at(transition)), starts_(std::move(starts)),
-      pi_ab_(std::move(pi_ab)), env_(recipe.make_env()) {
+      pi_ab_(std::move(pi_ab)), env_(recipe.make_env()),
+      after_(recipe.skills, recipe.meta, std::move(trained), SwitchRule::IntervalEnd) {
   if (starts_.size() == 0) throw Error("switch training: S_a is empty");
   const EnvSpec& spec = env_->spec();
   const int D = spec.obs_dim;
@@ -106,7 +109,7 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
     int a = random ? (t == switch_at ? SwitchQNetworkImpl::kSwitch : SwitchQNetworkImpl::kStay) : greedy(full_.data());
     if (a == SwitchQNetworkImpl::kSwitch) {
       std::copy(full_.begin(), full_.end(), scratch_.begin());
-      bool ok = run_subtask(*env_, recipe_, tr_.to, full_.data(), cfg_.max_subtask_steps, &env_steps_);
+      bool ok = run_subtask(*env_, recipe_, after_, tr_.to, full_.data(), cfg_.lookahead, cfg_.max_subtask_steps, &env_steps_);
       store(scratch_.data(), a, ok ? cfg_.r_success : cfg_.r_fail, scratch_.data(), true);
       return {ok, t};
     }
@@ -121,7 +124,7 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
     }
     if (left) {  // the interval ran out: the forced switch, valued by pi_b's outcome
       std::copy(next_full_.begin(), next_full_.end(), scratch_.begin());
-      bool ok = run_subtask(*env_, recipe_, tr_.to, scratch_.data(), cfg_.max_subtask_steps, &env_steps_);
+      bool ok = run_subtask(*env_, recipe_, after_, tr_.to, scratch_.data(), cfg_.lookahead, cfg_.max_subtask_steps, &env_steps_);
       store(full_.data(), a, ok ? cfg_.r_success : cfg_.r_fail, next_full_.data(), true);
       return {ok, t + 1};
     }

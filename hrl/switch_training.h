@@ -3,7 +3,8 @@
 // pi_ab hands control to pi_b. An attempt starts from a state of S_a; at every state q_ab
 // picks stay (pi_ab acts one step) or switch (pi_b takes over and runs its subtask).
 // Rewards (spec): switch -> r_s if pi_b then achieves its subtask, r_f if it fails;
-// stay -> r_f on a fall, else 0. Every reward but the uneventful stay ends the attempt.
+// stay -> r_f on a fall, else 0. How far "its subtask" reaches is config.lookahead
+// (run_subtask below). Every reward but the uneventful stay ends the attempt.
 // Where the interval runs out while staying, control passes to pi_b as it does when the
 // method runs (the forced switch), and that last stay is valued by pi_b's outcome. The
 // paper's Algorithm 2 gives r_f there instead, which teaches q_ab that switching at any
@@ -19,16 +20,21 @@
 #include "hrl/collection.h"
 #include "hrl/composite_recipe.h"
 #include "hrl/pipeline_config.h"
+#include "hrl/transition_controller.h"
 
 namespace segue {
 
-// Runs pi_b from the state in `obs` (the task observation, updated in place) until its
-// subtask ends: it succeeds when the meta-controller would start the next transition out
-// of b, when the episode reaches its time limit, or after max_steps; it fails when the
-// episode terminates first (a fall, a contact).
+// Runs the episode on from the state in `obs` (the task observation, updated in place)
+// with pi_b (`to_skill`) in control, driven on by `after`, until `lookahead` transition
+// intervals have begun. It succeeds then, when the episode reaches its time limit, or after
+// max_steps; it fails when the episode terminates first (a fall, a contact).
+// lookahead 1 is the paper's "pi_b achieves its subtask": the next transition out of b
+// starts, and `after` only runs pi_b. With more, `after` (the meta-controller with the
+// trained transition policies, With TP) carries on through the following transitions, so
+// a hand-over that leaves pi_b standing but badly placed for the next skill is a failure.
 // `steps` (optional) is increased by the environment steps taken.
-bool run_subtask(Env& env, const CompositeRecipe& recipe, int to_skill, float* obs, int max_steps,
-                 int64_t* steps = nullptr);
+bool run_subtask(Env& env, const CompositeRecipe& recipe, TransitionController& after, int to_skill, float* obs,
+                 int lookahead, int max_steps, int64_t* steps = nullptr);
 
 struct SwitchStats {
   int attempts = 0;
@@ -39,8 +45,10 @@ struct SwitchStats {
 
 class SwitchTrainer {
  public:
+  // `trained`: the recipe's transition policies (by transition; missing ones are taken
+  // as Without TP), which carry the episode on after pi_b when config.lookahead > 1.
   SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& recipe, int transition, StartStates starts,
-                Policy transition_policy, uint64_t seed);
+                Policy transition_policy, std::vector<TransitionArtefacts> trained, uint64_t seed);
   // Runs `n` attempts (with their updates) and reports on them.
   SwitchStats run(int n);
   int attempts_done() const { return attempts_; }
@@ -68,6 +76,7 @@ class SwitchTrainer {
   StartStates starts_;
   Policy pi_ab_;
   std::unique_ptr<Env> env_;
+  TransitionController after_;  // judges a hand-over: pi_b, then With TP (run_subtask)
   SwitchQNetwork q_{nullptr}, target_{nullptr};
   std::unique_ptr<torch::optim::Adam> opt_;
   EigenMlp q_copy_;  // per-step inference

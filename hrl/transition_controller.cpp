@@ -4,12 +4,19 @@ namespace segue {
 
 TransitionController::TransitionController(const std::vector<Skill>& skills, const MetaController& meta,
                                            std::vector<TransitionArtefacts> artefacts, SwitchRule rule)
-    : skills_(skills), meta_(meta), artefacts_(std::move(artefacts)), rule_(rule) {}
+    : skills_(skills), meta_(meta), artefacts_(std::move(artefacts)), rule_(rule) {
+  artefacts_.resize(meta_.transitions().size());  // those not given: Without TP
+}
 
 void TransitionController::reset(const Env& env, const float*) {
   features_.resize(env.spec().feature_names.size());
   env.features(features_.data());
-  skill_ = meta_.start_skill(features_.data());
+  resume(env, meta_.start_skill(features_.data()));
+}
+
+void TransitionController::resume(const Env& env, int skill) {
+  features_.resize(env.spec().feature_names.size());
+  skill_ = skill;
   transition_ = -1;
 }
 

@@ -29,6 +29,9 @@ class TransitionController : public Controller {
   TransitionController(const std::vector<Skill>& skills, const MetaController& meta,
                        std::vector<TransitionArtefacts> artefacts, SwitchRule rule);
   void reset(const Env& env, const float* obs) override;
+  // Carries on an episode already under way with `skill` in control and no transition
+  // running (switch training hands the episode over here after pi_ab).
+  void resume(const Env& env, int skill);
   void act(const Env& env, const float* obs, float* action) override;
   int skill() const { return skill_; }
   int transition() const { return transition_; }  // the transition pi_ab is running, or -1

@@ -125,4 +125,19 @@ TEST(PpoLearning, CheckpointResumeRestoresEverythingButInFlightEpisodes) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(PpoLearning, SetLogStdReopensExploration) {
+  // A continued run's `init_log_std`: the Gaussian's log density at its own mean is then
+  // sum_j (-log_std - log(2 pi) / 2) = 6 (1 - 0.9189385) for log std -1 in all 6 dims.
+  at::set_num_threads(1);
+  ShortWalker s;
+  VectorEnv envs(s.make, 2, 1);
+  PPO ppo(s.cfg, s.spec, envs, 5);
+  ppo.set_log_std(-1.0);
+  std::vector<float> obs(26, 0.2f), mean(6);
+  ppo.policy().act(obs.data(), 1, mean.data());  // |mean| < 1 for a fresh net: not clipped
+  double want = 6 * (1.0 - 0.5 * std::log(2 * M_PI));
+  EXPECT_NEAR(ppo.log_prob(obs.data(), mean.data(), 1).item<double>(), want, 1e-4);
+  EXPECT_NEAR(ppo.net()->log_std.mean().item<double>(), -1.0, 1e-7);
+}
+
 }  // namespace segue

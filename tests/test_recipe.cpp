@@ -101,6 +101,10 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run("train " + (dir_ / "missing.yaml").string()), "missing.yaml: cannot read recipe");
   auto ok = write("ok.yaml", "task: walker_forward\n");
   expect_one_line_error(run("train " + ok + " --set ppo.lrr=1"), "unknown key 'ppo.lrr' (from --set)");
+  auto std_alone = write("std.yaml", "task: walker_forward\ninit_log_std: -1\n");
+  expect_one_line_error(run("train " + std_alone), "key 'init_log_std': applies to a run that starts from init_from");
+  auto curbs = write("curbs.yaml", "task: walker_jump\nenv: {curbs: 0}\n");
+  expect_one_line_error(run("train " + curbs), "key 'env.curbs': must be at least 1");
 }
 
 TEST_F(CliErrors, BadPoliciesAndFlags) {

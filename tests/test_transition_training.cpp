@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "core/assets.h"
 #include "environments/registry.h"
 #include "hrl/lee_transition.h"
 #include "hrl/pipeline.h"
@@ -126,7 +127,7 @@ TEST_F(TransitionTraining, GeneratorRewardsAreEq3OfTheDiscriminator) {
 TEST_F(TransitionTraining, SwitchQNetworkExportsAsAPolicy) {
   CompositeRecipe r = tiny();
   const Skill& b = r.skills[r.meta.transitions()[0].to];
-  SwitchTrainer trainer(r.pipeline.switching, r, 0, collect_start_states(r, 0, 6, 1), b.policy, 4);
+  SwitchTrainer trainer(r.pipeline.switching, r, 0, collect_start_states(r, 0, 6, 1), b.policy, {}, 4);
   SwitchStats s = trainer.run(24);
   EXPECT_EQ(s.attempts, 24);
   EXPECT_GE(s.success_rate, 0.0);
@@ -194,6 +195,61 @@ TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
   }
 }
 
+TEST_F(TransitionTraining, SubtaskLookaheadEndsAtTheTasksOwnEvents) {
+  // All four Patrol transitions, the shipped transition policies, long episodes. After
+  // pi_{forward,balance} has run its interval, balance's own subtask is over at once
+  // (lookahead 1: 0 steps); with lookahead 2 the episode runs on through balance -> walk and the walk
+  // until the walker passes the next stone (since_turn = 0); with 3, until the
+  // walk -> balance interval after that turn has ended (since_turn = 101).
+  std::string file = path("patrol4.yaml");
+  std::string text = kTinyPatrol;
+  text.replace(text.find("seed: 3"), 0,
+               "  - {from: backward, to: balance, when: {since_turn: [0, 100]}}\n"
+               "  - {from: balance, to: forward, when: {direction: 1, since_turn: [100, 1.0e+6], progress: [-1.0e+6, 4]}}\n"
+               "  - {from: balance, to: backward, when: {direction: -1, since_turn: [100, 1.0e+6], progress: [-1.0e+6, 4]}}\n");
+  std::ofstream(file) << text;
+  CompositeRecipe r = CompositeRecipe::load(file, {"env.max_episode_steps=5000", "run_dir=" + path("run4")});
+  ASSERT_EQ(r.meta.transitions().size(), 4u);
+  auto shipped = load_transition_artefacts(r, repo_path("assets/policies/walker/patrol"), "policy.pt", false);
+  TransitionController after(r.skills, r.meta, shipped, SwitchRule::IntervalEnd);
+  const Transition& fb = r.meta.transitions()[0];
+  const Skill& balance = r.skills[fb.to];
+  StartStates starts = collect_start_states(r, 0, 6, 2);
+  auto env = r.make_env();
+  std::vector<float> obs(r.spec.obs_dim), act(r.spec.act_dim);
+  std::vector<double> f(r.spec.feature_names.size()), x, state;
+  int reached[4] = {};
+  for (int i = 0; i < starts.size(); ++i) {
+    starts.state(i, state);
+    env->restore_state(state, obs.data());
+    bool fell = false;
+    for (env->features(f.data()); MetaController::holds(fb.when, f.data()) && !fell; env->features(f.data())) {
+      shipped[0].policy->act(obs.data() + balance.obs_begin, 1, act.data());
+      fell = env->step(act.data(), obs.data()).terminated;
+    }
+    if (fell) continue;
+    env->save_state(x);
+    const int since_x = int(f[1]);
+    for (int lookahead : {1, 2, 3}) {
+      env->restore_state(x, obs.data());
+      int64_t steps = 0;
+      bool ok = run_subtask(*env, r, after, fb.to, obs.data(), lookahead, 5000, &steps);
+      env->features(f.data());
+      if (lookahead == 1) {  // balance -> walk's interval holds already (since_turn >= 100)
+        EXPECT_TRUE(ok);
+        EXPECT_EQ(steps, 0) << i;
+        EXPECT_EQ(int(f[1]), since_x);
+      }
+      if (!ok) break;  // a fall: later lookaheads fail too
+      if (lookahead == 2) EXPECT_EQ(f[1], 0.0) << i << ": ended at the next turn";
+      // The walk -> balance interval [0, 100] runs to its end before balance hands over.
+      if (lookahead == 3) EXPECT_EQ(f[1], 101.0) << i << ": ended when walk -> balance's interval did";
+      ++reached[lookahead];
+    }
+  }
+  EXPECT_GT(reached[3], 0) << "no episode got through a whole walk: lookahead 2 and 3 were not checked";
+}
+
 TEST_F(TransitionTraining, LeeEpisodesEndAtTheTerminationOutputWithPiBsOutcome) {
   CompositeRecipe r = tiny();
   StartStates starts = collect_start_states(r, 0, 4, 1);
@@ -217,7 +273,8 @@ TEST_F(TransitionTraining, LeeEpisodesEndAtTheTerminationOutputWithPiBsOutcome) 
     auto task = r.make_env();
     std::vector<float> full(r.spec.obs_dim);
     task->restore_state(at_end, full.data());
-    EXPECT_EQ(sr.info.success, run_subtask(*task, r, r.meta.transitions()[0].to, full.data(), 500)) << seed;
+    TransitionController pi_b(r.skills, r.meta, {}, SwitchRule::IntervalEnd);
+    EXPECT_EQ(sr.info.success, run_subtask(*task, r, pi_b, r.meta.transitions()[0].to, full.data(), 1, 500)) << seed;
     auto episodes = env.take_finished();
     ASSERT_EQ(episodes.size(), 1u);
     EXPECT_EQ(episodes[0].states.size(), 3u * obs.size());  // s_0, s_1, s_2 = s_T

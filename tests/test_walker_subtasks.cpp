@@ -101,15 +101,19 @@ TEST(WalkerJump, EpisodeEndsPastX15) {
 }
 
 TEST(WalkerJump, SnapshotCarriesTheCurbPosition) {
-  auto a = make_task("walker_jump", "{push_prob: 0}"), b = make_task("walker_jump", "{push_prob: 0}");
+  // Two curbs of random heights, so the snapshot must carry each curb's height too.
+  const char* opts = "{push_prob: 0, curbs: 2, curb_height_min: 0.1}";
+  auto a = make_task("walker_jump", opts), b = make_task("walker_jump", opts);
   std::vector<float> oa(28), ob(28), act(6);
   a->reset(3, oa.data());
   b->reset(4, ob.data());  // a different curb position
   shift_x(*a, 4.0, oa);    // within detection, so the curb shows in the observation
-  std::vector<double> s;
+  std::vector<double> s, s2;
   a->save_state(s);
   b->restore_state(s, ob.data());
   EXPECT_EQ(oa, ob);
+  b->save_state(s2);
+  EXPECT_EQ(s, s2);
   for (int t = 0; t < 100; ++t) {
     Rng r(t);
     for (auto& x : act) x = float(r.symmetric(1));
@@ -118,6 +122,79 @@ TEST(WalkerJump, SnapshotCarriesTheCurbPosition) {
     ASSERT_EQ(ra.reward, rb.reward) << t;
     if (ra.done()) break;
   }
+}
+
+TEST(WalkerJump, TrainingLayoutWithSeveralCurbs) {
+  auto env = make_task("walker_jump", "{curbs: 3, curb_spacing: 8, curb_noise: 0, push_prob: 0}");
+  std::vector<float> obs(28);
+  env->reset(1, obs.data());
+  // Curbs at 7, 15 and 23 (0.2 thick). Past the first, the observation shows the second.
+  shift_x(*env, 12.0, obs);
+  EXPECT_NEAR(obs[26], 3.0, 1e-6);
+  EXPECT_NEAR(obs[27], 3.2, 1e-6);
+  StepResult r = env->step(kZero, obs.data());
+  EXPECT_EQ(r.info.success_count, 1);
+  EXPECT_FALSE(r.info.success);  // success is every curb
+  EXPECT_FALSE(r.terminated);    // the end moves with the layout: 15 + 2 x 8
+  shift_x(*env, 30.5, obs);
+  r = env->step(kZero, obs.data());
+  EXPECT_EQ(r.info.success_count, 3);
+  EXPECT_TRUE(r.info.success);
+  EXPECT_FALSE(r.terminated);
+  shift_x(*env, 31.5, obs);
+  EXPECT_TRUE(env->step(kZero, obs.data()).terminated);
+}
+
+TEST(WalkerJump, ClearanceTermByHand) {
+  // Two identical tasks but for the clearance term: their rewards differ by exactly it.
+  const char* base =
+      "{curb_noise: 0, init_noise: 0, init_random_steps: 0, push_prob: 0, clearance_before: 1, clearance_weight: %s}";
+  char with[200], without[200];
+  std::snprintf(with, sizeof with, base, "2");
+  std::snprintf(without, sizeof without, base, "0");
+  auto a = make_task("walker_jump", with), b = make_task("walker_jump", without);
+  std::vector<float> oa(28), ob(28);
+  auto place = [](Env& env, double x, std::vector<float>& obs) {
+    auto& m = dynamic_cast<MujocoEnv&>(env);
+    m.mutable_data()->qpos[0] = x;
+    m.mutable_data()->qpos[1] = 1.45;  // 0.2 m up: foot bottoms at 0.1 - 0.06 + 0.2 = 0.24
+    m.mutable_data()->qpos[6] = -0.3;  // left thigh swung: its foot 0.04 m higher, 0.28 m back
+    m.forward(obs.data());
+  };
+  // The lower foot (the right, 0.24 m up) counts: w 0.24 / 0.4 from 1 m before the curb
+  // (the walker's smallest x, the left foot's, is then 0.56 m before it) to its end.
+  for (auto [x, expected] : {std::pair{6.72, 2.0 * (0.24 / 0.4)},
+                             std::pair{3.0, 0.0},     // far from it
+                             std::pair{7.55, 0.0}}) { // past its end (left foot at 7.27)
+    a->reset(0, oa.data());
+    b->reset(0, ob.data());
+    place(*a, x, oa);
+    place(*b, x, ob);
+    double diff = a->step(kZero, oa.data()).reward - b->step(kZero, ob.data()).reward;
+    EXPECT_NEAR(diff, expected, 0.01) << "x " << x;  // one control step of free fall moves the feet ~0.3 mm
+  }
+}
+
+TEST(WalkerCrawl, CrouchTermByHand) {
+  // Same state in two tasks differing only in the crouch term: rewards differ by
+  // crouch_weight |torso z - crouch_height|, with the walker lifted to a torso z of 1.45 m
+  // (x = 0, no ceiling; lifted, not lowered, so no foot is pushed into the floor).
+  const char* opts = "{push_prob: 0, init_noise: 0, init_random_steps: 0, crouch_weight: %s, crouch_height: 0.6}";
+  char with[200], without[200];
+  std::snprintf(with, sizeof with, opts, "3");
+  std::snprintf(without, sizeof without, opts, "0");
+  auto a = make_task("walker_crawl", with), b = make_task("walker_crawl", without);
+  std::vector<float> oa(26), ob(26);
+  a->reset(0, oa.data());
+  b->reset(0, ob.data());
+  for (Env* e : {a.get(), b.get()}) {
+    auto& m = dynamic_cast<MujocoEnv&>(*e);
+    m.mutable_data()->qpos[1] = 1.45;
+    m.forward(e == a.get() ? oa.data() : ob.data());
+  }
+  StepResult ra = a->step(kZero, oa.data()), rb = b->step(kZero, ob.data());
+  // One control step of free fall moves the torso ~0.3 mm.
+  EXPECT_NEAR(ra.reward - rb.reward, -3.0 * (1.45 - 0.6), 0.01);
 }
 
 TEST(WalkerCrawl, StandingUnderTheCeilingTouchesIt) {
