@@ -1,5 +1,7 @@
 #include "hrl/collection.h"
 
+#include <spdlog/spdlog.h>
+
 #include <sstream>
 
 #include "core/rng.h"
@@ -37,6 +39,9 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
       controller.act(*env, obs.data(), act.data());
       done = env->step(act.data(), obs.data()).done();
     }
+    // A late interval is reached only as often as every earlier hand-over succeeds.
+    if ((e + 1) % 1000 == 0)
+      spdlog::info("  S_a: {}/{} states after {} episodes (at most {})", out.size(), count, e + 1, max_episodes);
   }
   if (out.size() < count)
     throw Error(r.file + ": transition " + r.transition_name(transition) + " was entered only " +
