@@ -14,11 +14,9 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
   auto env = r.make_env();
   const EnvSpec& spec = env->spec();
   const Transition& tr = r.meta.transitions().at(transition);
-  std::vector<TransitionArtefacts> artefacts = trained;
-  artefacts.resize(r.meta.transitions().size());
   bool any_q = false;
-  for (const auto& a : artefacts) any_q |= bool(a.q);
-  TransitionController controller(r.skills, r.meta, artefacts, any_q ? SwitchRule::QNetwork : SwitchRule::IntervalEnd);
+  for (const auto& a : trained) any_q |= bool(a.q);
+  TransitionController controller(r.skills, r.meta, trained, any_q ? SwitchRule::QNetwork : SwitchRule::IntervalEnd);
   std::vector<float> obs(spec.obs_dim), act(spec.act_dim);
   std::vector<double> f(spec.feature_names.size()), state;
   StartStates out;

@@ -78,9 +78,9 @@ ControllerFactory method_controllers(const CompositeRecipe& r, const std::string
   if (method == "without-tp") {
     // The meta-controller switches straight to the next skill as the interval begins:
     // transition controllers with no transition policy trained.
-    std::vector<TransitionArtefacts> none(r.meta.transitions().size());
-    return [&r, none] {
-      return std::make_unique<TransitionController>(r.skills, r.meta, none, SwitchRule::IntervalEnd);
+    return [&r] {
+      return std::make_unique<TransitionController>(r.skills, r.meta, std::vector<TransitionArtefacts>{},
+                                                    SwitchRule::IntervalEnd);
     };
   }
   if (method == "single") {

@@ -8,7 +8,7 @@ namespace segue {
 
 LeeTransitionEnv::LeeTransitionEnv(const CompositeRecipe& r, int transition, StartStates starts,
                                    int max_subtask_steps)
-    : recipe_(r), to_(r.meta.transitions().at(transition).to),
+    : to_(r.meta.transitions().at(transition).to),
       inner_(r.make_env(), std::move(starts), r.meta.transitions()[transition].when, r.skills[to_].obs_begin,
              r.skills[to_].obs_end),
       max_subtask_steps_(max_subtask_steps),
@@ -48,7 +48,7 @@ StepResult LeeTransitionEnv::step(const float* action, float* obs) {
   bool success = false;
   if (hand_over) {
     after_ = inner_.task_obs();  // pi_b runs on from here; obs keeps s_T
-    success = run_subtask(inner_.task(), recipe_, pi_b_, to_, after_.data(), /*lookahead=*/1, max_subtask_steps_);
+    success = run_subtask(inner_.task(), pi_b_, to_, after_.data(), /*lookahead=*/1, max_subtask_steps_);
   }
   if (hand_over || r.terminated) {
     r.terminated = true, r.truncated = false;

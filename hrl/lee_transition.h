@@ -39,7 +39,6 @@ class LeeTransitionEnv : public Env {
   std::vector<Episode> take_finished() { return std::move(finished_); }
 
  private:
-  const CompositeRecipe& recipe_;
   int to_;
   TransitionEnv inner_;  // S_a starts, pi_b's slice, the interval's end
   int max_subtask_steps_;

@@ -6,8 +6,8 @@
 
 namespace segue {
 
-bool run_subtask(Env& env, const CompositeRecipe& r, TransitionController& after, int to, float* obs,
-                 int lookahead, int max_steps, int64_t* steps) {
+bool run_subtask(Env& env, TransitionController& after, int to, float* obs, int lookahead, int max_steps,
+                 int64_t* steps) {
   std::vector<float> act(env.spec().act_dim);
   after.resume(env, to);
   int begun = 0;
@@ -77,6 +77,10 @@ void SwitchTrainer::normalize(const float* in, float* out) const {
   for (size_t j = 0; j < mean_.size(); ++j) out[j] = std::clamp((in[j] - mean_[j]) * inv_std_[j], -5.0f, 5.0f);
 }
 
+bool SwitchTrainer::hand_over(float* obs) {
+  return run_subtask(*env_, after_, tr_.to, obs, cfg_.lookahead, cfg_.max_subtask_steps, &env_steps_);
+}
+
 int SwitchTrainer::greedy(const float* obs) {
   normalize(obs, scratch_.data());
   q_copy_.forward(scratch_.data(), 1, qvals_.data());
@@ -109,7 +113,7 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
     int a = random ? (t == switch_at ? SwitchQNetworkImpl::kSwitch : SwitchQNetworkImpl::kStay) : greedy(full_.data());
     if (a == SwitchQNetworkImpl::kSwitch) {
       std::copy(full_.begin(), full_.end(), scratch_.begin());
-      bool ok = run_subtask(*env_, recipe_, after_, tr_.to, full_.data(), cfg_.lookahead, cfg_.max_subtask_steps, &env_steps_);
+      bool ok = hand_over(full_.data());
       store(scratch_.data(), a, ok ? cfg_.r_success : cfg_.r_fail, scratch_.data(), true);
       return {ok, t};
     }
@@ -124,7 +128,7 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
     }
     if (left) {  // the interval ran out: the forced switch, valued by pi_b's outcome
       std::copy(next_full_.begin(), next_full_.end(), scratch_.begin());
-      bool ok = run_subtask(*env_, recipe_, after_, tr_.to, scratch_.data(), cfg_.lookahead, cfg_.max_subtask_steps, &env_steps_);
+      bool ok = hand_over(scratch_.data());
       store(full_.data(), a, ok ? cfg_.r_success : cfg_.r_fail, next_full_.data(), true);
       return {ok, t + 1};
     }

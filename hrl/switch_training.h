@@ -33,8 +33,8 @@ namespace segue {
 // trained transition policies, With TP) carries on through the following transitions, so
 // a hand-over that leaves pi_b standing but badly placed for the next skill is a failure.
 // `steps` (optional) is increased by the environment steps taken.
-bool run_subtask(Env& env, const CompositeRecipe& recipe, TransitionController& after, int to_skill, float* obs,
-                 int lookahead, int max_steps, int64_t* steps = nullptr);
+bool run_subtask(Env& env, TransitionController& after, int to_skill, float* obs, int lookahead, int max_steps,
+                 int64_t* steps = nullptr);
 
 struct SwitchStats {
   int attempts = 0;
@@ -67,6 +67,8 @@ class SwitchTrainer {
   void store(const float* s, int a, double r, const float* s2, bool done);
   double update();
   int greedy(const float* obs);
+  // pi_b takes over at the state in `obs` (the task observation, updated in place): did it succeed?
+  bool hand_over(float* obs);
   // q_ab's input: (s - mean) / std from the probe, clipped to +-5 (as q_function() exports).
   void normalize(const float* in, float* out) const;
 

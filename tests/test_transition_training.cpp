@@ -233,7 +233,7 @@ TEST_F(TransitionTraining, SubtaskLookaheadEndsAtTheTasksOwnEvents) {
     for (int lookahead : {1, 2, 3}) {
       env->restore_state(x, obs.data());
       int64_t steps = 0;
-      bool ok = run_subtask(*env, r, after, fb.to, obs.data(), lookahead, 5000, &steps);
+      bool ok = run_subtask(*env, after, fb.to, obs.data(), lookahead, 5000, &steps);
       env->features(f.data());
       if (lookahead == 1) {  // balance -> walk's interval holds already (since_turn >= 100)
         EXPECT_TRUE(ok);
@@ -274,7 +274,7 @@ TEST_F(TransitionTraining, LeeEpisodesEndAtTheTerminationOutputWithPiBsOutcome) 
     std::vector<float> full(r.spec.obs_dim);
     task->restore_state(at_end, full.data());
     TransitionController pi_b(r.skills, r.meta, {}, SwitchRule::IntervalEnd);
-    EXPECT_EQ(sr.info.success, run_subtask(*task, r, pi_b, r.meta.transitions()[0].to, full.data(), 1, 500)) << seed;
+    EXPECT_EQ(sr.info.success, run_subtask(*task, pi_b, r.meta.transitions()[0].to, full.data(), 1, 500)) << seed;
     auto episodes = env.take_finished();
     ASSERT_EQ(episodes.size(), 1u);
     EXPECT_EQ(episodes[0].states.size(), 3u * obs.size());  // s_0, s_1, s_2 = s_T
