@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <string>
 
 #include "core/rng.h"
 #include "tests/task_fixture.h"
@@ -19,6 +21,20 @@ void shift_x(Env& env, double x, std::vector<float>& obs) {
 }
 
 const float kZero[6] = {0, 0, 0, 0, 0, 0};
+
+// The reward of one zero-action step of `task` (with `settings`) from its seed-0 start
+// after `place` has edited qpos: two calls that differ in one reward term's weight differ
+// by exactly that term.
+double reward_after_placing(const std::string& task, const std::string& settings,
+                            const std::function<void(double* qpos)>& place) {
+  auto env = make_task(task, settings);
+  std::vector<float> obs(env->spec().obs_dim);
+  env->reset(0, obs.data());
+  auto& m = dynamic_cast<MujocoEnv&>(*env);
+  place(m.mutable_data()->qpos);
+  m.forward(obs.data());
+  return env->step(kZero, obs.data()).reward;
+}
 
 }  // namespace
 
@@ -146,55 +162,33 @@ TEST(WalkerJump, TrainingLayoutWithSeveralCurbs) {
 }
 
 TEST(WalkerJump, ClearanceTermByHand) {
-  // Two identical tasks but for the clearance term: their rewards differ by exactly it.
-  const char* base =
-      "{curb_noise: 0, init_noise: 0, init_random_steps: 0, push_prob: 0, clearance_before: 1, clearance_weight: %s}";
-  char with[200], without[200];
-  std::snprintf(with, sizeof with, base, "2");
-  std::snprintf(without, sizeof without, base, "0");
-  auto a = make_task("walker_jump", with), b = make_task("walker_jump", without);
-  std::vector<float> oa(28), ob(28);
-  auto place = [](Env& env, double x, std::vector<float>& obs) {
-    auto& m = dynamic_cast<MujocoEnv&>(env);
-    m.mutable_data()->qpos[0] = x;
-    m.mutable_data()->qpos[1] = 1.45;  // 0.2 m up: foot bottoms at 0.1 - 0.06 + 0.2 = 0.24
-    m.mutable_data()->qpos[6] = -0.3;  // left thigh swung: its foot 0.04 m higher, 0.28 m back
-    m.forward(obs.data());
-  };
+  const std::string base =
+      "{curb_noise: 0, init_noise: 0, init_random_steps: 0, push_prob: 0, clearance_before: 1, clearance_weight: ";
   // The lower foot (the right, 0.24 m up) counts: w 0.24 / 0.4 from 1 m before the curb
   // (the walker's smallest x, the left foot's, is then 0.56 m before it) to its end.
   for (auto [x, expected] : {std::pair{6.72, 2.0 * (0.24 / 0.4)},
                              std::pair{3.0, 0.0},     // far from it
                              std::pair{7.55, 0.0}}) { // past its end (left foot at 7.27)
-    a->reset(0, oa.data());
-    b->reset(0, ob.data());
-    place(*a, x, oa);
-    place(*b, x, ob);
-    double diff = a->step(kZero, oa.data()).reward - b->step(kZero, ob.data()).reward;
+    auto place = [x = x](double* qpos) {
+      qpos[0] = x;
+      qpos[1] = 1.45;  // 0.2 m up: foot bottoms at 0.1 - 0.06 + 0.2 = 0.24
+      qpos[6] = -0.3;  // left thigh swung: its foot 0.04 m higher, 0.28 m back
+    };
+    double diff = reward_after_placing("walker_jump", base + "2}", place) -
+                  reward_after_placing("walker_jump", base + "0}", place);
     EXPECT_NEAR(diff, expected, 0.01) << "x " << x;  // one control step of free fall moves the feet ~0.3 mm
   }
 }
 
 TEST(WalkerCrawl, CrouchTermByHand) {
-  // Same state in two tasks differing only in the crouch term: rewards differ by
-  // crouch_weight |torso z - crouch_height|, with the walker lifted to a torso z of 1.45 m
-  // (x = 0, no ceiling; lifted, not lowered, so no foot is pushed into the floor).
-  const char* opts = "{push_prob: 0, init_noise: 0, init_random_steps: 0, crouch_weight: %s, crouch_height: 0.6}";
-  char with[200], without[200];
-  std::snprintf(with, sizeof with, opts, "3");
-  std::snprintf(without, sizeof without, opts, "0");
-  auto a = make_task("walker_crawl", with), b = make_task("walker_crawl", without);
-  std::vector<float> oa(26), ob(26);
-  a->reset(0, oa.data());
-  b->reset(0, ob.data());
-  for (Env* e : {a.get(), b.get()}) {
-    auto& m = dynamic_cast<MujocoEnv&>(*e);
-    m.mutable_data()->qpos[1] = 1.45;
-    m.forward(e == a.get() ? oa.data() : ob.data());
-  }
-  StepResult ra = a->step(kZero, oa.data()), rb = b->step(kZero, ob.data());
-  // One control step of free fall moves the torso ~0.3 mm.
-  EXPECT_NEAR(ra.reward - rb.reward, -3.0 * (1.45 - 0.6), 0.01);
+  // Rewards differ by crouch_weight |torso z - crouch_height|, with the walker lifted to a
+  // torso z of 1.45 m (x = 0, no ceiling; lifted, not lowered, so no foot is pushed into
+  // the floor). One control step of free fall moves the torso ~0.3 mm.
+  const std::string base = "{push_prob: 0, init_noise: 0, init_random_steps: 0, crouch_height: 0.6, crouch_weight: ";
+  auto lift = [](double* qpos) { qpos[1] = 1.45; };
+  double diff = reward_after_placing("walker_crawl", base + "3}", lift) -
+                reward_after_placing("walker_crawl", base + "0}", lift);
+  EXPECT_NEAR(diff, -3.0 * (1.45 - 0.6), 0.01);
 }
 
 TEST(WalkerCrawl, StandingUnderTheCeilingTouchesIt) {
