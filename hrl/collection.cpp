@@ -25,16 +25,19 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
     env->reset(mix_seed(seed, e), obs.data());
     controller.reset(*env, obs.data());
     for (bool done = false; !done && out.size() < count;) {
+      // The interval a->b begins where the meta-controller hands a's phase to b. That phase
+      // may be driven by a transition policy into a rather than by pi_a itself: on Patrol,
+      // balance->walk begins at the very step walk->balance's interval ends, so balance
+      // never runs alone and "pi_a in control" would find no state at all.
       env->features(f.data());
-      // pi_a is running and the interval a->b begins: this state belongs to S_a.
-      if (controller.transition() < 0 && controller.skill() == tr.from &&
-          r.meta.active_transition(tr.from, f.data()) == transition) {
-        env->save_state(state);
+      const bool in_a = controller.skill() == tr.from;
+      if (in_a) env->save_state(state);
+      controller.act(*env, obs.data(), act.data());
+      if (in_a && controller.skill() == tr.to && r.meta.active_transition(tr.from, f.data()) == transition) {
         out.state_dim = int(state.size());
         out.states.insert(out.states.end(), state.begin(), state.end());
-        out.obs.insert(out.obs.end(), obs.begin(), obs.end());
+        out.obs.insert(out.obs.end(), obs.begin(), obs.end());  // act() leaves obs as it was
       }
-      controller.act(*env, obs.data(), act.data());
       done = env->step(act.data(), obs.data()).done();
     }
     // A late interval is reached only as often as every earlier hand-over succeeds.

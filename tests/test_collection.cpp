@@ -2,8 +2,10 @@
 // exactly; T_b is pi_b's own contiguous trajectory inside its window; files round-trip.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
+#include "core/assets.h"
 #include "hrl/collection.h"
 
 namespace segue {
@@ -83,6 +85,31 @@ TEST(Collection, DemonstrationsArePiBsOwnStepsInItsWindow) {
   EXPECT_EQ(s2.states, s.states);
   EXPECT_EQ(s2.obs, s.obs);
   std::filesystem::remove_all(dir);
+}
+
+TEST(Collection, StartStatesWhereATransitionPolicyIntoAHandsOver) {
+  // On Patrol balance never runs alone: With TP, walk->balance's pi_ab drives the 100
+  // balance steps and balance->walk's interval begins the step after. S_a of balance->
+  // forward is the state where that hand-over happens, with balance's phase done.
+  CompositeRecipe r = patrol();
+  const int t = 2;
+  ASSERT_EQ(r.transition_name(t), "balance-forward");
+  auto trained = load_transition_artefacts(r, repo_path(r.transitions_dir), "policy.pt", false);
+  StartStates s = collect_start_states(r, t, 3, 7, trained, 50);
+  ASSERT_EQ(s.size(), 3);
+  auto env = r.make_env();
+  std::vector<float> obs(s.obs_dim);
+  std::vector<double> f(env->spec().feature_names.size());
+  const auto& names = env->spec().feature_names;
+  const int since_turn = int(std::find(names.begin(), names.end(), "since_turn") - names.begin());
+  for (int i = 0; i < s.size(); ++i) {
+    std::vector<double> state;
+    s.state(i, state);
+    env->restore_state(state, obs.data());
+    env->features(f.data());
+    EXPECT_TRUE(MetaController::holds(r.meta.transitions()[t].when, f.data())) << "state " << i;
+    EXPECT_EQ(f[since_turn], 101) << "the interval's first state (walk->balance holds to 100)";
+  }
 }
 
 TEST(Collection, RefusesATransitionThatIsNeverEntered) {
