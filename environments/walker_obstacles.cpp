@@ -153,6 +153,7 @@ void WalkerJump::reset_task() {
   set_obstacles(layout);
   for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
   crossed_ = 0;
+  peak_curb_ = -1, peak_ = 0.0;
   WalkerEnv::reset_task();
 }
 
@@ -178,9 +179,13 @@ StepResult WalkerJump::evaluate(const float* action) {
   if (next >= 0) {
     const Obstacle& curb = obstacles_[next];
     if (x > curb.start - 1.0 && x < curb.end) r.reward += jcfg_.upward_weight * std::max(z_velocity(), 0.0);
-    if (jcfg_.clearance_weight > 0 && x > curb.start - jcfg_.clearance_before && x < curb.end)
-      r.reward += jcfg_.clearance_weight *
-                  std::min(clearance(foot_, heights_[next]), clearance(foot_left_, heights_[next]));
+    if (x > curb.start - jcfg_.clearance_before && x < curb.end) {
+      const double lower = std::min(clearance(foot_, heights_[next]), clearance(foot_left_, heights_[next]));
+      r.reward += jcfg_.clearance_weight * lower;
+      if (peak_curb_ != next) peak_curb_ = next, peak_ = 0.0;
+      const double rise = lower * heights_[next] - peak_;
+      if (rise > 0) r.reward += jcfg_.peak_weight * rise, peak_ += rise;
+    }
   }
   bool contact = touching();
   if (contact) r.reward -= ocfg_.contact_penalty;
@@ -194,12 +199,16 @@ StepResult WalkerJump::evaluate(const float* action) {
 
 void WalkerJump::save_extra(std::vector<double>& out) const {
   out.push_back(crossed_);
+  out.push_back(peak_curb_);
+  out.push_back(peak_);
   out.insert(out.end(), heights_.begin(), heights_.end());
 }
 void WalkerJump::restore_extra(const double* in, size_t n) {
   crossed_ = n > 0 ? int(in[0]) : 0;
+  peak_curb_ = n > 1 ? int(in[1]) : -1;
+  peak_ = n > 2 ? in[2] : 0.0;
   heights_.assign(obstacles_.size(), jcfg_.curb_height);
-  for (size_t k = 0; k + 1 < n && k < heights_.size(); ++k) heights_[k] = in[1 + k];
+  for (size_t k = 0; k + 3 < n && k < heights_.size(); ++k) heights_[k] = in[3 + k];
   for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
 }
 

@@ -89,6 +89,12 @@ class WalkerJump : public WalkerObstacleEnv {
     // the walker is over or up to clearance_before before the next curb: both feet off the
     // ground together is a jump, which the crossing bonuses pay only once it succeeds.
     double clearance_weight = 0.0, clearance_before = 0.3;
+    // + peak_weight times each rise of the lower foot's bottom to a new height for this
+    // curb (up to the curb's height), in the same window: in all, peak_weight times the
+    // highest both feet were off the ground together. Unlike upward_weight, which pays
+    // every upward movement and so pays many small hops as well as one high one, this pays
+    // only the height of the highest.
+    double peak_weight = 0.0;
   };
   WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
 
@@ -106,6 +112,8 @@ class WalkerJump : public WalkerObstacleEnv {
 
   Config jcfg_;
   int crossed_ = 0;              // marks (start, centre, end of each curb) the trailing foot has crossed
+  int peak_curb_ = -1;           // the curb peak_ belongs to
+  double peak_ = 0.0;            // highest lower-foot clearance (m) in that curb's window so far
   std::vector<double> heights_;  // per curb
 };
 

@@ -10,7 +10,8 @@
 namespace segue {
 
 StartStates collect_start_states(const CompositeRecipe& r, int transition, int count, uint64_t seed,
-                                 const std::vector<TransitionArtefacts>& trained, int max_episodes) {
+                                 const std::vector<TransitionArtefacts>& trained, int max_episodes,
+                                 const std::atomic<int>* stop) {
   auto env = r.make_env();
   const EnvSpec& spec = env->spec();
   const Transition& tr = r.meta.transitions().at(transition);
@@ -22,6 +23,7 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
   StartStates out;
   out.obs_dim = spec.obs_dim;
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {
+    if (stop && stop->load()) return out;
     env->reset(mix_seed(seed, e), obs.data());
     controller.reset(*env, obs.data());
     for (bool done = false; !done && out.size() < count;) {
@@ -52,7 +54,7 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
 }
 
 Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, int count, uint64_t seed,
-                                      int max_episodes) {
+                                      int max_episodes, const std::atomic<int>* stop) {
   auto env = r.make_env();
   const EnvSpec& spec = env->spec();
   const Transition& tr = r.meta.transitions().at(transition);
@@ -64,6 +66,7 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
   out.obs_dim = D;
   out.act_dim = spec.act_dim;
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {
+    if (stop && stop->load()) return out;
     env->reset(mix_seed(seed, e), obs.data());
     bool entered = false;
     for (bool done = false; !done && out.size() < count;) {

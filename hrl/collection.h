@@ -9,6 +9,7 @@
 //        recorded while the transition's `expert.when` holds. Observations are in pi_b's
 //        slice of the task observation.
 // Both are stored as tensors in a .pt file (torch.load-able) that later stages read back.
+#include <atomic>
 #include <string>
 #include <vector>
 
@@ -38,10 +39,12 @@ struct Demonstrations {
 // throws segue::Error if `max_episodes` pass without enough.
 // `trained`: per transition of the recipe, its pi_ab and q_ab where already trained (or
 // empty). Episodes use q_ab where there is one, else switch at the interval's end.
+// `stop` (a signal's flag): when set, both return at the next episode with what they have.
 StartStates collect_start_states(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
-                                 const std::vector<TransitionArtefacts>& trained = {}, int max_episodes = 20000);
+                                 const std::vector<TransitionArtefacts>& trained = {}, int max_episodes = 20000,
+                                 const std::atomic<int>* stop = nullptr);
 Demonstrations collect_demonstrations(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
-                                      int max_episodes = 100000);
+                                      int max_episodes = 100000, const std::atomic<int>* stop = nullptr);
 
 void save(const StartStates& s, const std::string& path);
 void save(const Demonstrations& d, const std::string& path);

@@ -21,19 +21,25 @@ namespace fs = std::filesystem;
 
 bool exists(const std::string& path) { return fs::exists(path); }
 
-void collect(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir) {
+// Returns the signal number when stopped (nothing of the unfinished set is kept), else 0.
+int collect(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
+            const std::atomic<int>* stop) {
   const CollectConfig& c = r.pipeline.collect;
+  auto stopped = [&] { return stop && stop->load() ? stop->load() : 0; };
   if (!exists(dir + "/start_states.pt")) {
     spdlog::info("  collecting S_a: {} states where pi_a enters the interval", c.start_states);
-    save(collect_start_states(r, t, c.start_states, mix_seed(r.pipeline.seed, 2 * t),
-                              load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false)),
-         dir + "/start_states.pt");
+    StartStates s = collect_start_states(r, t, c.start_states, mix_seed(r.pipeline.seed, 2 * t),
+                                         load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false), 20000, stop);
+    if (stopped()) return stopped();
+    save(s, dir + "/start_states.pt");
   }
   if (!exists(dir + "/demonstrations.pt")) {
     spdlog::info("  collecting T_b: {} steps of pi_b in its own interval", c.demonstrations);
-    save(collect_demonstrations(r, t, c.demonstrations, mix_seed(r.pipeline.seed, 2 * t + 1)),
-         dir + "/demonstrations.pt");
+    Demonstrations d = collect_demonstrations(r, t, c.demonstrations, mix_seed(r.pipeline.seed, 2 * t + 1), 100000, stop);
+    if (stopped()) return stopped();
+    save(d, dir + "/demonstrations.pt");
   }
+  return 0;
 }
 
 // PPO iterations of `trainer` (a TransitionPolicyTrainer or LeeTrainer) to the budget,
@@ -125,7 +131,9 @@ int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const Pip
   return stop;
 }
 
-void train_switch(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir) {
+// Returns the signal number when stopped (the stage has no checkpoint: it restarts), else 0.
+int train_switch(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
+                 const std::atomic<int>* stop) {
   const SwitchConfig& cfg = r.pipeline.switching;
   SwitchTrainer trainer(cfg, r, t, load_start_states(dir + "/start_states.pt"), Policy::load(dir + "/policy.pt"),
                         load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false),
@@ -135,6 +143,7 @@ void train_switch(const CompositeRecipe& r, int t, const std::string& run, const
   auto t0 = std::chrono::steady_clock::now();
   SwitchStats s;
   while (trainer.attempts_done() < cfg.attempts) {
+    if (stop && stop->load()) return stop->load();
     s = trainer.run(std::min(chunk, cfg.attempts - trainer.attempts_done()));
     double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     csv.write({double(trainer.attempts_done()), s.epsilon, s.success_rate, s.switch_step, s.loss,
@@ -146,6 +155,7 @@ void train_switch(const CompositeRecipe& r, int t, const std::string& run, const
   double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   spdlog::info("  q_ab: {} attempts, {} environment steps in {}", cfg.attempts, trainer.env_steps(),
                format_duration(secs));
+  return 0;
 }
 
 // Fig. 4's data: from the same S_a states, each of pi_a, pi_ab and pi_b drives through
@@ -205,7 +215,7 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
       return 0;
     }
     int stop = train();
-    if (stop) spdlog::warn("interrupted: checkpoint saved; rerun the same command to resume");
+    if (stop) spdlog::warn("interrupted: rerun the same command to resume (from the last checkpoint where the stage has one)");
     return stop;
   };
   auto tdir = [&](int t) { return run + "/" + recipe.transition_name(t); };
@@ -214,18 +224,18 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
   for (int t = 0; t < n; ++t) {
     fs::create_directories(tdir(t));
     announce(recipe.transition_name(t) + ": collect S_a and T_b");
-    collect(recipe, t, run, tdir(t));
+    if (int stop = collect(recipe, t, run, tdir(t), o.stop)) {
+      spdlog::warn("interrupted: rerun the same command to resume (this collection starts over)");
+      return stop;
+    }
     announce(recipe.transition_name(t) + ": transition policy (AIRL, Algorithm 1)");
     if (int stop = stage_unless_done(tdir(t) + "/policy.pt", [&] { return train_transition(recipe, t, tdir(t), o); }))
       return stop;
   }
   for (int t = 0; t < n; ++t) {
     announce(recipe.transition_name(t) + ": switch Q-network (double DQN, Algorithm 2)");
-    stage_unless_done(tdir(t) + "/q.pt", [&] {
-      train_switch(recipe, t, run, tdir(t));
-      return 0;
-    });
-    if (o.stop && o.stop->load()) return o.stop->load();
+    if (int stop = stage_unless_done(tdir(t) + "/q.pt", [&] { return train_switch(recipe, t, run, tdir(t), o.stop); }))
+      return stop;
   }
   for (int t = 0; t < n && lee; ++t) {
     announce(recipe.transition_name(t) + ": Lee et al. 2019 baseline (proximity reward, termination head)");

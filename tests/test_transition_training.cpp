@@ -286,12 +286,16 @@ TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
   CompositeRecipe r = tiny();
   PipelineOptions o;
   o.command = "test";
-  // Stopped at once: collection finishes, the transition stage checkpoints after one
-  // iteration and the run returns the signal.
+  // Stopped at once: the collection keeps nothing and the run returns the signal.
   std::atomic<int> stop{15};
   o.stop = &stop;
   EXPECT_EQ(run_pipeline(r, o), 15);
   const std::string t = path("run/forward-balance/");
+  EXPECT_FALSE(fs::exists(t + "start_states.pt"));
+  // With S_a and T_b in place, the transition stage checkpoints after one iteration.
+  save(collect_start_states(r, 0, r.pipeline.collect.start_states, 1), t + "start_states.pt");
+  save(collect_demonstrations(r, 0, r.pipeline.collect.demonstrations, 2), t + "demonstrations.pt");
+  EXPECT_EQ(run_pipeline(r, o), 15);
   EXPECT_TRUE(fs::exists(t + "transition_checkpoint.pt"));
   EXPECT_FALSE(fs::exists(t + "policy.pt"));
   // Resumed: every stage finishes, each iteration logged once.

@@ -180,6 +180,32 @@ TEST(WalkerJump, ClearanceTermByHand) {
   }
 }
 
+TEST(WalkerJump, PeakTermPaysOnlyNewHeights) {
+  // peak_weight w pays each rise of the lower foot's bottom above its best so far for
+  // this curb: placed 0.24 m up in the window, then the same, then 0.34 m up, then past
+  // the curb: w 0.24, 0, w 0.10, 0 (each step falls the same ~0.3 mm from rest).
+  const std::string base =
+      "{curb_noise: 0, init_noise: 0, init_random_steps: 0, push_prob: 0, clearance_before: 1, peak_weight: ";
+  auto with = make_task("walker_jump", base + "100}"), without = make_task("walker_jump", base + "0}");
+  std::vector<float> obs(28);
+  with->reset(0, obs.data());
+  without->reset(0, obs.data());
+  const std::pair<double, double> placements[] = {{6.72, 1.45}, {6.72, 1.45}, {6.72, 1.55}, {7.55, 1.55}};
+  const double expected[] = {100 * 0.24, 0.0, 100 * 0.10, 0.0};
+  for (int k = 0; k < 4; ++k) {
+    double reward[2];
+    for (int e = 0; e < 2; ++e) {
+      auto& m = dynamic_cast<MujocoEnv&>(e == 0 ? *with : *without);
+      double* qpos = m.mutable_data()->qpos;
+      qpos[0] = placements[k].first, qpos[1] = placements[k].second, qpos[6] = -0.3;  // as above
+      std::fill(m.mutable_data()->qvel, m.mutable_data()->qvel + 9, 0.0);  // each step from rest
+      m.forward(obs.data());
+      reward[e] = (e == 0 ? *with : *without).step(kZero, obs.data()).reward;
+    }
+    EXPECT_NEAR(reward[0] - reward[1], expected[k], 0.05) << "placement " << k;
+  }
+}
+
 TEST(WalkerCrawl, CrouchTermByHand) {
   // Rewards differ by crouch_weight |torso z - crouch_height|, with the walker lifted to a
   // torso z of 1.45 m (x = 0, no ceiling; lifted, not lowered, so no foot is pushed into
