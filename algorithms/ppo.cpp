@@ -24,6 +24,7 @@ PpoConfig PpoConfig::read(const Section& s, PpoConfig c) {
   c.clip = s.get("clip", c.clip);
   c.vf_coef = s.get("vf_coef", c.vf_coef);
   c.ent_coef = s.get("ent_coef", c.ent_coef);
+  c.min_log_std = s.get("min_log_std", c.min_log_std);
   c.max_grad_norm = s.get("max_grad_norm", c.max_grad_norm);
   c.normalize_reward = s.get("normalize_reward", c.normalize_reward);
   c.obs_clip = s.get("obs_clip", c.obs_clip);
@@ -208,6 +209,10 @@ void PPO::update(IterationStats& stats) {
       loss.total.backward();
       torch::nn::utils::clip_grad_norm_(net_->parameters(), cfg_.max_grad_norm);
       optimizer_->step();
+      if (cfg_.min_log_std > -20.0) {
+        torch::NoGradGuard no_grad;
+        net_->log_std.clamp_min_(cfg_.min_log_std);
+      }
       double total = loss.total.item<double>();
       if (!std::isfinite(total))
         throw Error("PPO loss became " + std::to_string(total) + " at iteration " +

@@ -31,6 +31,10 @@ struct PpoConfig {
   double clip = 0.2;
   double vf_coef = 0.5;
   double ent_coef = 0.0;
+  // A floor under the policy's log std, kept after every update: PPO here has no working
+  // entropy bonus at these scales (ent_coef 0.01 blew the std up on the jump, 0.003 did
+  // not stop it falling to 0.04), so a continued run may need exploration held open.
+  double min_log_std = -20.0;       // -20: no floor
   double max_grad_norm = 0.5;
   bool normalize_reward = true;     // scale rewards by the std of the discounted return
   double obs_clip = 10.0;

@@ -140,4 +140,25 @@ TEST(PpoLearning, SetLogStdReopensExploration) {
   EXPECT_NEAR(ppo.net()->log_std.mean().item<double>(), -1.0, 1e-7);
 }
 
+TEST(PpoLearning, MinLogStdHoldsExplorationOpen) {
+  // From log std -3, one iteration of updates moves it by a few learning-rate steps at
+  // most (Adam: 10 steps of lr 1e-3 move it under 0.01); with a floor at -2 it sits there.
+  at::set_num_threads(1);
+  for (double floor : {-20.0, -2.0}) {
+    ShortWalker s;
+    s.cfg.min_log_std = floor;
+    VectorEnv envs(s.make, 2, 1);
+    PPO ppo(s.cfg, s.spec, envs, 5);
+    ppo.set_log_std(-3.0);
+    ppo.iterate();
+    auto ls = ppo.net()->log_std;
+    if (floor < -3) {
+      EXPECT_LT(ls.max().item<double>(), -2.9);
+    } else {
+      EXPECT_GE(ls.min().item<double>(), -2.0);
+      EXPECT_LT(ls.max().item<double>(), -1.9);
+    }
+  }
+}
+
 }  // namespace segue
