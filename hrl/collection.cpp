@@ -32,10 +32,10 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
       // balance->walk begins at the very step walk->balance's interval ends, so balance
       // never runs alone and "pi_a in control" would find no state at all.
       env->features(f.data());
-      const bool in_a = controller.skill() == tr.from;
-      if (in_a) env->save_state(state);
+      const bool begins = controller.skill() == tr.from && r.meta.active_transition(tr.from, f.data()) == transition;
+      if (begins) env->save_state(state);
       controller.act(*env, obs.data(), act.data());
-      if (in_a && controller.skill() == tr.to && r.meta.active_transition(tr.from, f.data()) == transition) {
+      if (begins && controller.skill() == tr.to) {  // the hand-over to b happened at this state
         out.state_dim = int(state.size());
         out.states.insert(out.states.end(), state.begin(), state.end());
         out.obs.insert(out.obs.end(), obs.begin(), obs.end());  // act() leaves obs as it was

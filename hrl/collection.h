@@ -40,11 +40,12 @@ struct Demonstrations {
 // `trained`: per transition of the recipe, its pi_ab and q_ab where already trained (or
 // empty). Episodes use q_ab where there is one, else switch at the interval's end.
 // `stop` (a signal's flag): when set, both return at the next episode with what they have.
+constexpr int kStartStateEpisodes = 20000, kDemonstrationEpisodes = 100000;  // default max_episodes
 StartStates collect_start_states(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
-                                 const std::vector<TransitionArtefacts>& trained = {}, int max_episodes = 20000,
-                                 const std::atomic<int>* stop = nullptr);
+                                 const std::vector<TransitionArtefacts>& trained = {},
+                                 int max_episodes = kStartStateEpisodes, const std::atomic<int>* stop = nullptr);
 Demonstrations collect_demonstrations(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
-                                      int max_episodes = 100000, const std::atomic<int>* stop = nullptr);
+                                      int max_episodes = kDemonstrationEpisodes, const std::atomic<int>* stop = nullptr);
 
 void save(const StartStates& s, const std::string& path);
 void save(const Demonstrations& d, const std::string& path);

@@ -21,22 +21,26 @@ namespace fs = std::filesystem;
 
 bool exists(const std::string& path) { return fs::exists(path); }
 
+// The signal number that asked the run to stop, or 0.
+int signal_of(const std::atomic<int>* stop) { return stop ? stop->load() : 0; }
+
 // Returns the signal number when stopped (nothing of the unfinished set is kept), else 0.
 int collect(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
             const std::atomic<int>* stop) {
   const CollectConfig& c = r.pipeline.collect;
-  auto stopped = [&] { return stop && stop->load() ? stop->load() : 0; };
   if (!exists(dir + "/start_states.pt")) {
-    spdlog::info("  collecting S_a: {} states where pi_a enters the interval", c.start_states);
+    spdlog::info("  collecting S_a: {} states where the interval begins", c.start_states);
     StartStates s = collect_start_states(r, t, c.start_states, mix_seed(r.pipeline.seed, 2 * t),
-                                         load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false), 20000, stop);
-    if (stopped()) return stopped();
+                                         load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false),
+                                         kStartStateEpisodes, stop);
+    if (int sig = signal_of(stop)) return sig;
     save(s, dir + "/start_states.pt");
   }
   if (!exists(dir + "/demonstrations.pt")) {
     spdlog::info("  collecting T_b: {} steps of pi_b in its own interval", c.demonstrations);
-    Demonstrations d = collect_demonstrations(r, t, c.demonstrations, mix_seed(r.pipeline.seed, 2 * t + 1), 100000, stop);
-    if (stopped()) return stopped();
+    Demonstrations d = collect_demonstrations(r, t, c.demonstrations, mix_seed(r.pipeline.seed, 2 * t + 1),
+                                              kDemonstrationEpisodes, stop);
+    if (int sig = signal_of(stop)) return sig;
     save(d, dir + "/demonstrations.pt");
   }
   return 0;
@@ -55,7 +59,7 @@ int train_loop(Trainer& trainer, const CompositeRecipe& r, int64_t total_steps, 
     if (s.ppo.episodes > 0) recent = s.ppo.success_rate;
     csv.write(row(s));
     bool last = trainer.ppo().global_step() >= total_steps;
-    int stop = o.stop ? o.stop->load() : 0;
+    int stop = signal_of(o.stop);
     if (last || stop || s.ppo.iteration % 10 == 0) trainer.save(ckpt, r.resolved);
     progress.update(trainer.ppo().global_step(), s.ppo.episode_return, recent);
     if (stop && !last) {
@@ -143,7 +147,7 @@ int train_switch(const CompositeRecipe& r, int t, const std::string& run, const 
   auto t0 = std::chrono::steady_clock::now();
   SwitchStats s;
   while (trainer.attempts_done() < cfg.attempts) {
-    if (stop && stop->load()) return stop->load();
+    if (int sig = signal_of(stop)) return sig;
     s = trainer.run(std::min(chunk, cfg.attempts - trainer.attempts_done()));
     double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     csv.write({double(trainer.attempts_done()), s.epsilon, s.success_rate, s.switch_step, s.loss,

@@ -11,6 +11,7 @@
 
 #include "core/assets.h"
 #include "hrl/collection.h"
+#include "hrl/switch_training.h"
 
 using namespace segue;
 
@@ -33,19 +34,8 @@ int main(int argc, char** argv) {
     for (int i = 0; i < n; ++i, ++starts) {
       s.state(i % s.size(), state);
       env->restore_state(state, obs.data());
-      c.resume(*env, r.meta.transitions()[t].from);
-      int changes = 0, skill = c.skill();
-      for (int k = 0; k < 5000; ++k) {
-        c.act(*env, obs.data(), act.data());
-        if (c.skill() != skill && (skill = c.skill(), ++changes == 3)) break;  // into b, then two more
-        StepResult sr = env->step(act.data(), obs.data());
-        if (sr.terminated) break;
-        if (sr.truncated) {  // the episode's time limit: a success, as in run_subtask
-          changes = 3;
-          break;
-        }
-      }
-      ok += changes == 3;
+      // From a's phase: the transition into b is the first skill change, then two more.
+      ok += run_subtask(*env, c, r.meta.transitions()[t].from, obs.data(), /*lookahead=*/3, /*max_steps=*/5000);
     }
   } else {
     for (int e = 0; e < n; ++e) {
