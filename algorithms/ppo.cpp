@@ -243,7 +243,7 @@ torch::Tensor PPO::log_prob(const float* raw_obs, const float* actions, int64_t 
 }
 
 void PPO::init_actor(const Policy& p, float extra_bias) {
-  if (p.obs_dim() != buf_.obs_dim || p.act_dim() > buf_.act_dim)
+  if (p.obs_dim() > buf_.obs_dim || p.act_dim() > buf_.act_dim)
     throw Error("init_actor: the policy's sizes differ from the trainer's");
   const auto& ws = p.mlp().weights();
   const auto& bs = p.mlp().biases();
@@ -252,23 +252,29 @@ void PPO::init_actor(const Policy& p, float extra_bias) {
   for (auto& m : net_->actor->modules(/*include_self=*/false)) {
     auto* linear = m->as<torch::nn::Linear>();
     if (!linear) continue;
-    const bool last = layer + 1 == ws.size();
+    const bool first = layer == 0, last = layer + 1 == ws.size();
     const int64_t rows = ws.size() > layer ? ws[layer].rows() : -1;
-    if (layer >= ws.size() || linear->weight.size(1) != ws[layer].cols() ||
+    const int64_t cols = ws.size() > layer ? ws[layer].cols() : -1;
+    if (layer >= ws.size() || (first ? linear->weight.size(1) < cols : linear->weight.size(1) != cols) ||
         (last ? linear->weight.size(0) < rows : linear->weight.size(0) != rows))
       throw Error("init_actor: the policy's hidden layers differ from the trainer's");
+    if (first && linear->weight.size(1) > cols) linear->weight.zero_();
     if (last && linear->weight.size(0) > rows) {
       linear->weight.zero_();
       linear->bias.fill_(extra_bias);
     }
-    linear->weight.narrow(0, 0, rows).copy_(torch::from_blob(const_cast<float*>(ws[layer].data()), {rows, ws[layer].cols()}));
+    linear->weight.narrow(0, 0, rows).narrow(1, 0, cols).copy_(
+        torch::from_blob(const_cast<float*>(ws[layer].data()), {rows, cols}));
     linear->bias.narrow(0, 0, rows).copy_(torch::from_blob(const_cast<float*>(bs[layer].data()), {rows}));
     ++layer;
   }
   if (layer != ws.size()) throw Error("init_actor: the policy's hidden layers differ from the trainer's");
-  std::vector<double> mean(p.obs_mean().begin(), p.obs_mean().end()), var(mean.size());
-  for (size_t j = 0; j < var.size(); ++j)
+  // Inputs the policy does not see (beyond its obs_dim) start unscaled: mean 0, var 1.
+  std::vector<double> mean(buf_.obs_dim, 0.0), var(buf_.obs_dim, 1.0);
+  for (int j = 0; j < p.obs_dim(); ++j) {
+    mean[j] = p.obs_mean()[j];
     var[j] = std::max(1.0 / (double(p.obs_inv_std()[j]) * p.obs_inv_std()[j]) - obs_rms_.eps(), 0.0);
+  }
   // Weighted as much data as pi_b's training saw, so the first rollouts barely move it.
   obs_rms_.set(mean, var, 1e6);
   refresh_inference_copy();

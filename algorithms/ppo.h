@@ -84,7 +84,9 @@ class PPO {
   // Starts the actor from a trained policy (weights and observation normaliser); the log
   // std keeps its initial value. A transition policy can start as pi_b, whose behaviour it
   // is trained to match. The actor may have more outputs than the policy (Lee et al.'s
-  // termination head): those start at zero weight and bias `extra_bias`.
+  // termination head): those start at zero weight and bias `extra_bias`. The policy may
+  // see a prefix of the trainer's observation (a walker skill, before the obstacle pair):
+  // the other inputs start at zero weight, so the actor begins as exactly that policy.
   void init_actor(const Policy& policy, float extra_bias = 0.0f);
   // Sets every action dimension's log std: a run continued from a converged checkpoint
   // has next to no exploration left (PPO here has no entropy bonus).

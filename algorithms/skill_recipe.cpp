@@ -14,6 +14,9 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   s.checkpoint_every = root.get("checkpoint_every", s.checkpoint_every);
   s.init_from = root.get<std::string>("init_from", "");
   s.init_log_std = root.get("init_log_std", s.init_log_std);
+  s.init_policy = root.get<std::string>("init_policy", "");
+  if (!s.init_policy.empty() && !s.init_from.empty())
+    throw root.error("init_policy", "a run starts from init_from or init_policy, not both");
   if (!std::isnan(s.init_log_std) && s.init_from.empty())
     throw root.error("init_log_std", "applies to a run that starts from init_from");
   try {

@@ -8,6 +8,7 @@
 //   checkpoint_every: 5       # iterations
 //   init_from: runs/walker_jump/checkpoint.pt   # optional: continue an earlier run
 //   init_log_std: -1.0        # optional, with init_from: reset the policy's log std
+//   init_policy: assets/policies/walker/walker_forward.pt  # optional: start the actor as a skill
 //   env: {...}                # the task's settings (reference defaults)
 //   policy: {pi_hidden: [32, 32], vf_hidden: [32, 32], activation: tanh, init_log_std: -0.5}
 //   ppo: {...}                # see PpoConfig
@@ -37,6 +38,10 @@ struct SkillRecipe {
   // budget. "" = from scratch.
   std::string init_from;
   double init_log_std = NAN;  // with init_from: the log std to restart exploration at (NaN: keep)
+  // A shipped skill (TorchScript) the actor starts as, e.g. walking for the jump: its
+  // observation may be a prefix of this task's (the obstacle pair starts at zero weight).
+  // The critic, the log std (policy.init_log_std) and the counters start fresh.
+  std::string init_policy;
   int checkpoint_every = 5;
   int eval_episodes = 50;
   uint64_t eval_seed = 1000;

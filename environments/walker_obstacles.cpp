@@ -152,7 +152,7 @@ void WalkerJump::reset_task() {
   }
   set_obstacles(layout);
   for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
-  crossed_ = 0;
+  crossed_ = 0, touched_ = 0;
   peak_curb_ = -1, peak_ = 0.0;
   WalkerEnv::reset_task();
 }
@@ -171,9 +171,14 @@ StepResult WalkerJump::evaluate(const float* action) {
     const Obstacle& c = obstacles_[crossed_ / 3];
     const double at[3] = {c.start, 0.5 * (c.start + c.end), c.end};
     if (trailing_foot_x() <= at[crossed_ % 3]) break;
-    r.reward += jcfg_.cross_bonus;
+    if (!(touched_ >> (crossed_ / 3) & 1u)) r.reward += jcfg_.cross_bonus;
     ++crossed_;
   }
+  if (jcfg_.mark_upward_weight != 0.0)
+    for (const Obstacle& c : obstacles_)
+      for (double at : {c.start, 0.5 * (c.start + c.end), c.end})
+        if (x_before_ <= at && at < torso_x())
+          r.reward += jcfg_.mark_upward_weight * std::clamp(z_velocity(), -2.0, 2.0);
   double x = min_x();
   int next = next_obstacle();
   if (next >= 0) {
@@ -188,12 +193,16 @@ StepResult WalkerJump::evaluate(const float* action) {
     }
   }
   bool contact = touching();
-  if (contact) r.reward -= ocfg_.contact_penalty;
+  if (contact) {
+    r.reward -= ocfg_.contact_penalty;
+    if (next >= 0 && next < 32) touched_ |= 1u << next;
+  }
   update_passed();
-  r.info.success = passed_ == int(obstacles_.size());
+  r.info.success = passed_ == int(obstacles_.size()) && touched_ == 0;
   r.info.success_count = passed_;
   r.info.metrics[0] = v;
-  r.terminated = fallen() || contact || x > jcfg_.end_x + (jcfg_.curbs - 1) * jcfg_.curb_spacing;
+  r.terminated = fallen() || (contact && jcfg_.contact_ends) ||
+                 x > jcfg_.end_x + (jcfg_.curbs - 1) * jcfg_.curb_spacing;
   return r;
 }
 
@@ -201,14 +210,16 @@ void WalkerJump::save_extra(std::vector<double>& out) const {
   out.push_back(crossed_);
   out.push_back(peak_curb_);
   out.push_back(peak_);
+  out.push_back(touched_);
   out.insert(out.end(), heights_.begin(), heights_.end());
 }
 void WalkerJump::restore_extra(const double* in, size_t n) {
   crossed_ = n > 0 ? int(in[0]) : 0;
   peak_curb_ = n > 1 ? int(in[1]) : -1;
   peak_ = n > 2 ? in[2] : 0.0;
+  touched_ = n > 3 ? uint32_t(in[3]) : 0u;
   heights_.assign(obstacles_.size(), jcfg_.curb_height);
-  for (size_t k = 0; k + 3 < n && k < heights_.size(); ++k) heights_[k] = in[3 + k];
+  for (size_t k = 0; k + 4 < n && k < heights_.size(); ++k) heights_[k] = in[4 + k];
   for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
 }
 

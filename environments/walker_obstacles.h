@@ -95,6 +95,15 @@ class WalkerJump : public WalkerObstacleEnv {
     // every upward movement and so pays many small hops as well as one high one, this pays
     // only the height of the highest.
     double peak_weight = 0.0;
+    // + mark_upward_weight clip(vz, -2, 2) once as the torso passes each curb's start,
+    // centre and end (vz the torso's vertical speed): the reference's jump term, which
+    // pays rising, and charges falling, at the moments that decide a clearance.
+    double mark_upward_weight = 0.0;
+    // false (training only): touching a curb costs contact_penalty each step instead of
+    // ending the episode, and that curb's crossing bonuses are forfeit. A near miss then
+    // still shows what follows a crossing, and a clean crossing is worth the bonuses more
+    // than a touched one; the reference task ends on the first touch.
+    bool contact_ends = true;
   };
   WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
 
@@ -112,6 +121,7 @@ class WalkerJump : public WalkerObstacleEnv {
 
   Config jcfg_;
   int crossed_ = 0;              // marks (start, centre, end of each curb) the trailing foot has crossed
+  uint32_t touched_ = 0;         // bit k: curb k was touched (only with contact_ends false)
   int peak_curb_ = -1;           // the curb peak_ belongs to
   double peak_ = 0.0;            // highest lower-foot clearance (m) in that curb's window so far
   std::vector<double> heights_;  // per curb

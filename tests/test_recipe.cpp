@@ -103,6 +103,14 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run("train " + ok + " --set ppo.lrr=1"), "unknown key 'ppo.lrr' (from --set)");
   auto std_alone = write("std.yaml", "task: walker_forward\ninit_log_std: -1\n");
   expect_one_line_error(run("train " + std_alone), "key 'init_log_std': applies to a run that starts from init_from");
+  auto both = write("both.yaml", "task: walker_jump\ninit_from: a.pt\ninit_policy: b.pt\n");
+  expect_one_line_error(run("train " + both), "key 'init_policy': a run starts from init_from or init_policy, not both");
+  const std::string in_tmp = "run_dir: " + (dir_ / "start_run").string() + "\n";
+  auto nowhere = write("nowhere.yaml", "task: walker_jump\ninit_policy: nowhere.pt\n" + in_tmp);
+  expect_one_line_error(run("train " + nowhere), "nowhere.yaml: key 'init_policy': no such policy 'nowhere.pt'");
+  std::filesystem::remove_all(dir_ / "start_run");
+  auto wider = write("wider.yaml", "task: walker_forward\ninit_policy: assets/policies/walker/walker_jump.pt\n" + in_tmp);
+  expect_one_line_error(run("train " + wider), "key 'init_policy': 'assets/policies/walker/walker_jump.pt' takes obs_dim 28");
   auto curbs = write("curbs.yaml", "task: walker_jump\nenv: {curbs: 0}\n");
   expect_one_line_error(run("train " + curbs), "key 'env.curbs': must be at least 1");
 }

@@ -81,6 +81,34 @@ TEST_F(TransitionTraining, PiAbStartsAsPiB) {
   for (size_t i = 0; i < want.size(); ++i) ASSERT_NEAR(got[i], want[i], 1e-4) << i;
 }
 
+// A jump run may start as the shipped walk (recipe key init_policy): the walk sees the
+// first 26 inputs, and the obstacle pair starts at zero weight and unscaled.
+TEST_F(TransitionTraining, ActorStartsAsAPolicyOnAPrefixOfItsObservation) {
+  Policy walk = Policy::load(repo_path("assets/policies/walker/walker_forward.pt"));
+  VectorEnv envs(task_factory("walker_jump", Recipe::parse("{}", "j").root()), 2, 1);
+  ActorCriticSpec net;
+  net.obs_dim = envs.spec().obs_dim, net.act_dim = envs.spec().act_dim;
+  ASSERT_EQ(net.obs_dim, walk.obs_dim() + 2);
+  PPO ppo(PpoConfig(), net, envs, 1);
+  ppo.init_actor(walk);
+  auto obs = random_obs(16, net.obs_dim, 9);
+  std::vector<float> prefix(16 * walk.obs_dim());
+  for (int i = 0; i < 16; ++i)
+    std::copy_n(&obs[i * net.obs_dim], walk.obs_dim(), &prefix[i * walk.obs_dim()]);
+  std::vector<float> want(16 * 6), got(16 * 6);
+  walk.act(prefix.data(), 16, want.data());
+  ppo.policy().act(obs.data(), 16, got.data());
+  for (size_t i = 0; i < want.size(); ++i) ASSERT_NEAR(got[i], want[i], 1e-4) << i;
+  EXPECT_FLOAT_EQ(ppo.policy().obs_mean()[net.obs_dim - 1], 0.0f);
+  EXPECT_NEAR(ppo.policy().obs_inv_std()[net.obs_dim - 1], 1.0f, 1e-6);
+  // A policy that sees more than the task gives cannot start it.
+  VectorEnv walks(task_factory("walker_forward", Recipe::parse("{}", "w").root()), 2, 1);
+  ActorCriticSpec small = net;
+  small.obs_dim = walks.spec().obs_dim;
+  PPO narrow(PpoConfig(), small, walks, 1);
+  EXPECT_THROW(narrow.init_actor(ppo.policy()), Error);
+}
+
 TEST_F(TransitionTraining, GeneratorRewardsAreEq3OfTheDiscriminator) {
   for (std::string mode : {"airl", "airl_absorbing"}) {
     CompositeRecipe r = tiny({"transition.reward=" + mode, "transition.discriminator.steps=16"});

@@ -2,6 +2,7 @@
 // obstacle observations against hand-computed values, snapshots that carry the layout.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <string>
@@ -106,6 +107,35 @@ TEST(WalkerJump, PassingTheCurbSucceedsAndTouchingItFails) {
   EXPECT_LT(r.reward, -5.0);
 }
 
+TEST(WalkerJump, TouchingGoesOnButForfeitsTheCurbWithContactEndsFalse) {
+  // Training-only contact_ends false: a touch costs the penalty and goes on, and the
+  // touched curb's three crossing bonuses (10 each) are not paid. Twin envs, one touched.
+  const char* opts = "{curb_noise: 0, push_prob: 0, contact_ends: false, cross_bonus: 10}";
+  auto touched = make_task("walker_jump", opts), clean = make_task("walker_jump", opts);
+  std::vector<float> obs(28);
+  touched->reset(2, obs.data());
+  clean->reset(2, obs.data());
+  shift_x(*touched, 6.9, obs);  // the feet overlap the curb's start, as above
+  StepResult r = touched->step(kZero, obs.data());
+  EXPECT_FALSE(r.terminated);
+  EXPECT_LT(r.reward, -5.0);
+  // The touched walker takes the clean one's pose; both are put 1.5 m past the curb.
+  auto& from = dynamic_cast<MujocoEnv&>(*clean);
+  auto& to = dynamic_cast<MujocoEnv&>(*touched);
+  std::copy_n(from.mutable_data()->qpos, 9, to.mutable_data()->qpos);
+  std::copy_n(from.mutable_data()->qvel, 9, to.mutable_data()->qvel);
+  double reward[2];
+  for (int e = 0; e < 2; ++e) {
+    Env& env = e == 0 ? *touched : *clean;
+    shift_x(env, 7.2 + 1.5 + 0.05, obs);
+    r = env.step(kZero, obs.data());
+    reward[e] = r.reward;
+    EXPECT_EQ(r.info.success_count, 1);
+    EXPECT_EQ(r.info.success, e == 1) << "a touched curb is no success";
+  }
+  EXPECT_NEAR(reward[1] - reward[0], 3 * 10.0, 1e-6);
+}
+
 TEST(WalkerJump, EpisodeEndsPastX15) {
   auto env = make_task("walker_jump", "{curb_noise: 0, push_prob: 0}");
   std::vector<float> obs(28);
@@ -203,6 +233,37 @@ TEST(WalkerJump, PeakTermPaysOnlyNewHeights) {
       reward[e] = (e == 0 ? *with : *without).step(kZero, obs.data()).reward;
     }
     EXPECT_NEAR(reward[0] - reward[1], expected[k], 0.05) << "placement " << k;
+  }
+}
+
+TEST(WalkerJump, MarkUpwardTermPaysTheTorsoVerticalSpeedAsItPassesAMark) {
+  // The torso at x 6.99 moving at 3 m/s passes the curb's start (7.0) in one control step
+  // (0.024 m); 0.5 m up, its feet (bottoms at 0.54) clear the 0.4 m curb. The term pays
+  // w clip(vz, -2, 2) with vz after the step: rising 1 m/s, falling 3 m/s (clipped), and
+  // nothing from 6.9, where no mark is passed.
+  const std::string base =
+      "{curb_noise: 0, init_noise: 0, init_random_steps: 0, push_prob: 0, mark_upward_weight: ";
+  for (auto [x, vz] : {std::pair{6.99, 1.0}, std::pair{6.99, -3.0}, std::pair{6.9, 1.0}}) {
+    double reward[2], vz_after = 0;
+    for (int e = 0; e < 2; ++e) {
+      auto env = make_task("walker_jump", base + (e == 0 ? "100}" : "0}"));
+      std::vector<float> obs(28);
+      env->reset(0, obs.data());
+      auto& m = dynamic_cast<MujocoEnv&>(*env);
+      double* qpos = m.mutable_data()->qpos;
+      double* qvel = m.mutable_data()->qvel;
+      qpos[0] = x, qpos[1] = 1.75;
+      std::fill(qvel, qvel + 9, 0.0);
+      qvel[0] = 3.0, qvel[1] = vz;
+      m.forward(obs.data());
+      StepResult r = env->step(kZero, obs.data());
+      ASSERT_FALSE(r.terminated);
+      reward[e] = r.reward;
+      vz_after = m.mutable_data()->qvel[1];
+    }
+    const double expected = x > 6.95 ? 100 * std::clamp(vz_after, -2.0, 2.0) : 0.0;
+    EXPECT_NEAR(reward[0] - reward[1], expected, 1e-6) << "x " << x << " vz " << vz;
+    if (x > 6.95) EXPECT_NEAR(vz_after, vz - 9.81 * 0.008, 0.05);  // free flight for one step
   }
 }
 
