@@ -86,7 +86,6 @@ class CliErrors : public TempDirTest {
     EXPECT_EQ(std::count(r.output.begin(), r.output.end(), '\n'), 1) << r.output;
     EXPECT_NE(r.output.find(needle), std::string::npos) << r.output;
   }
-  std::filesystem::path dir_;
 };
 
 TEST_F(CliErrors, BadRecipes) {
@@ -108,7 +107,7 @@ TEST_F(CliErrors, BadRecipes) {
   const std::string in_tmp = "run_dir: " + (dir_ / "start_run").string() + "\n";
   auto nowhere = write("nowhere.yaml", "task: walker_jump\ninit_policy: nowhere.pt\n" + in_tmp);
   expect_one_line_error(run("train " + nowhere), "nowhere.yaml: key 'init_policy': no such policy 'nowhere.pt'");
-  std::filesystem::remove_all(dir_ / "start_run");
+  std::filesystem::remove_all(dir_ / "start_run");  // the refused run's folder, recipe and all
   auto wider = write("wider.yaml", "task: walker_forward\ninit_policy: assets/policies/walker/walker_jump.pt\n" + in_tmp);
   expect_one_line_error(run("train " + wider), "key 'init_policy': 'assets/policies/walker/walker_jump.pt' takes obs_dim 28");
   auto curbs = write("curbs.yaml", "task: walker_jump\nenv: {curbs: 0}\n");
