@@ -4,6 +4,7 @@
 // reset. Obstacle observations follow the reference: (start - x, end - x) of the next
 // obstacle, x the smallest x of torso and feet, or fixed "far" values when the next
 // obstacle is beyond the detection distance.
+#include <array>
 #include <vector>
 
 #include "environments/walker.h"
@@ -115,6 +116,8 @@ class WalkerJump : public WalkerObstacleEnv {
 
  private:
   static constexpr double kFootRadius = 0.06;  // walker_base.xml's foot capsules
+  // The three points of a curb the bonuses are paid at: its start, centre and end.
+  static std::array<double, 3> bonus_points(const Obstacle& c) { return {c.start, 0.5 * (c.start + c.end), c.end}; }
   // How far the bottom of `foot` (a body id) is above the ground, as a fraction of the
   // curb's height, in [0, 1].
   double clearance(int foot, double height) const;
