@@ -31,8 +31,8 @@ void Policy::act(const float* obs, int batch, float* actions) const {
       actions[size_t(b) * k + j] = std::clamp(actions[size_t(b) * k + j], act_low_[j], act_high_[j]);
 }
 
-void Policy::check_fits(const EnvSpec& spec, const std::string& path) const {
-  if (obs_dim() != spec.obs_dim || act_dim() != spec.act_dim)
+void Policy::check_fits(const EnvSpec& spec, const std::string& path, bool prefix) const {
+  if ((prefix ? obs_dim() > spec.obs_dim : obs_dim() != spec.obs_dim) || act_dim() != spec.act_dim)
     throw Error(path + ": policy takes obs_dim " + std::to_string(obs_dim()) + " / act_dim " +
                 std::to_string(act_dim()) + ", but task '" + spec.name + "' has obs_dim " +
                 std::to_string(spec.obs_dim) + " / act_dim " + std::to_string(spec.act_dim));

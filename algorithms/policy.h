@@ -30,8 +30,9 @@ class Policy {
   void export_torchscript(const std::string& path) const;
   // Reads an exported .pt or a training checkpoint; throws segue::Error naming the file.
   static Policy load(const std::string& path);
-  // Refuses a policy whose sizes do not fit the task.
-  void check_fits(const EnvSpec& spec, const std::string& path) const;
+  // Refuses a policy whose sizes do not fit the task; with `prefix`, the policy may see
+  // the first obs_dim() numbers of a longer observation.
+  void check_fits(const EnvSpec& spec, const std::string& path, bool prefix = false) const;
 
  private:
   static Policy load_torchscript(const std::string& path);

@@ -109,7 +109,7 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run("train " + nowhere), "nowhere.yaml: key 'init_policy': no such policy 'nowhere.pt'");
   std::filesystem::remove_all(dir_ / "start_run");  // the refused run's folder, recipe and all
   auto wider = write("wider.yaml", "task: walker_forward\ninit_policy: assets/policies/walker/walker_jump.pt\n" + in_tmp);
-  expect_one_line_error(run("train " + wider), "key 'init_policy': 'assets/policies/walker/walker_jump.pt' takes obs_dim 28");
+  expect_one_line_error(run("train " + wider), "key 'init_policy': 'assets/policies/walker/walker_jump.pt': policy takes obs_dim 28");
   auto curbs = write("curbs.yaml", "task: walker_jump\nenv: {curbs: 0}\n");
   expect_one_line_error(run("train " + curbs), "key 'env.curbs': must be at least 1");
 }

@@ -63,16 +63,12 @@ int train_main(int argc, char** argv) {
     if (!std::filesystem::exists(from))
       throw Error(recipe_path + ": key 'init_policy': no such policy '" + s.init_policy + "'");
     Policy start = Policy::load(from);
-    const EnvSpec& spec = envs.spec();
-    if (start.obs_dim() > spec.obs_dim || start.act_dim() != spec.act_dim)
-      throw Error(recipe_path + ": key 'init_policy': '" + s.init_policy + "' takes obs_dim " +
-                  std::to_string(start.obs_dim()) + " / act_dim " + std::to_string(start.act_dim()) + ", but task '" +
-                  s.task + "' has obs_dim " + std::to_string(spec.obs_dim) + " / act_dim " +
-                  std::to_string(spec.act_dim) + " (the policy must see a prefix of the observation)");
+    const std::string key = recipe_path + ": key 'init_policy': '" + s.init_policy + "'";
+    start.check_fits(envs.spec(), key, /*prefix=*/true);
     try {
       ppo.init_actor(start);
     } catch (const Error& e) {
-      throw Error(recipe_path + ": key 'init_policy': '" + s.init_policy + "': " + e.what());
+      throw Error(key + ": " + e.what());
     }
     spdlog::info("training {} in {} with the actor of {} to {} steps", s.task, dir.path(), s.init_policy,
                  s.ppo.total_steps);
