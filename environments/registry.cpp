@@ -48,6 +48,8 @@ Factory walker_jump(const std::string& name, const Section& env) {
   j.peak_weight = env.get("peak_weight", j.peak_weight);
   j.contact_ends = env.get("contact_ends", j.contact_ends);
   j.mark_upward_weight = env.get("mark_upward_weight", j.mark_upward_weight);
+  j.ghost_curbs = env.get("ghost_curbs", j.ghost_curbs);
+  j.ghost_depth_cost = env.get("ghost_depth_cost", j.ghost_depth_cost);
   if (j.curbs < 1) throw env.error("curbs", "must be at least 1");
   if (j.curbs > 1 && j.curb_spacing <= 2 * j.curb_noise + o.curb_width)
     throw env.error("curb_spacing", "must exceed 2 curb_noise + curb_width so curbs do not overlap");

@@ -6,6 +6,19 @@
 
 namespace segue {
 
+double capsule_depth_in_box(const std::array<double, 2>& p0, const std::array<double, 2>& p1, double r,
+                            double x0, double x1, double height) {
+  double deepest = 0.0;
+  for (int i = 0; i <= 8; ++i) {
+    const double t = i / 8.0, x = p0[0] + t * (p1[0] - p0[0]), z = p0[1] + t * (p1[1] - p0[1]);
+    const double dx = std::max({x0 - x, x - x1, 0.0}), dz = std::max({-z, z - height, 0.0});
+    const double signed_distance = (dx > 0 || dz > 0) ? std::hypot(dx, dz)
+                                                      : -std::min({x - x0, x1 - x, z, height - z});
+    deepest = std::max(deepest, r - signed_distance);
+  }
+  return deepest;
+}
+
 ObstacleConfig ObstacleConfig::read(const Section& s, ObstacleConfig c) {
   c.detect_distance = s.get("detect_distance", c.detect_distance);
   c.curb_far_start = s.get("curb_far_start", c.curb_far_start);
@@ -66,6 +79,10 @@ void WalkerObstacleEnv::set_curb_height(size_t index, double height) {
   model_->geom_pos[3 * g + 2] = 0.5 * height;
   const double* s = &model_->geom_size[3 * g];
   model_->geom_rbound[g] = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+}
+
+void WalkerObstacleEnv::make_curbs_ghosts() {
+  for (int g : curb_geoms_) model_->geom_contype[g] = model_->geom_conaffinity[g] = 0;
 }
 
 int WalkerObstacleEnv::next_obstacle() const {
@@ -140,7 +157,24 @@ void WalkerObstacleEnv::restore_task_state(const double* in, size_t n) {
 // ---- jump ------------------------------------------------------------------------------
 
 WalkerJump::WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c)
-    : WalkerObstacleEnv(name, w, o, true), jcfg_(c) {}
+    : WalkerObstacleEnv(name, w, o, true), jcfg_(c) {
+  if (!jcfg_.ghost_curbs) return;
+  make_curbs_ghosts();
+  for (int g = 0; g < model_->ngeom; ++g)
+    if (model_->geom_bodyid[g] != 0 && model_->geom_type[g] == mjGEOM_CAPSULE) walker_capsules_.push_back(g);
+}
+
+double WalkerJump::depth_in_curb(const Obstacle& c, double height) const {
+  double depth = 0.0;
+  for (int g : walker_capsules_) {
+    const double* p = &data_->geom_xpos[3 * g];
+    const double* m = &data_->geom_xmat[9 * g];
+    const double half = model_->geom_size[3 * g + 1];  // the axis is the geom's local z
+    depth += capsule_depth_in_box({p[0] - half * m[2], p[2] - half * m[8]}, {p[0] + half * m[2], p[2] + half * m[8]},
+                                  model_->geom_size[3 * g], c.start, c.end, height);
+  }
+  return depth;
+}
 
 void WalkerJump::reset_task() {
   std::vector<Obstacle> layout;
@@ -190,8 +224,17 @@ StepResult WalkerJump::evaluate(const float* action) {
       if (rise > 0) r.reward += jcfg_.peak_weight * rise, peak_ += rise;
     }
   }
-  bool contact = touching();
-  if (contact) {
+  bool contact = false;
+  if (jcfg_.ghost_curbs) {
+    for (size_t k = 0; k < obstacles_.size(); ++k) {
+      if (std::abs(obstacles_[k].start - torso_x()) > 2.0) continue;  // out of the walker's reach
+      const double depth = depth_in_curb(obstacles_[k], heights_[k]);
+      if (depth <= 0) continue;
+      contact = true, touched_ |= 1u << k;
+      r.reward -= jcfg_.ghost_depth_cost * depth;
+    }
+    if (contact) r.reward -= ocfg_.contact_penalty;
+  } else if ((contact = touching())) {
     r.reward -= ocfg_.contact_penalty;
     if (next >= 0 && next < 32) touched_ |= 1u << next;
   }

@@ -13,6 +13,13 @@ namespace segue {
 
 enum class ObstacleKind { Curb = 1, Ceiling = 2 };
 
+// How deep a capsule (axis p0-p1, radius r, points as (x, z)) reaches into the box
+// [x0, x1] x [0, height] standing on the floor, in the walker's x-z plane: the largest
+// r - signed distance to the box over nine points along the axis (a close approximation
+// that is exact when the deepest point is one of them), 0 when it stays clear.
+double capsule_depth_in_box(const std::array<double, 2>& p0, const std::array<double, 2>& p1, double r,
+                            double x0, double x1, double height);
+
 struct Obstacle {
   ObstacleKind kind;
   double start, end;  // x extent
@@ -51,6 +58,8 @@ class WalkerObstacleEnv : public WalkerEnv {
   void set_obstacles(const std::vector<Obstacle>& layout);
   // Resizes the index-th curb of the layout to this height (it stands on the floor).
   void set_curb_height(size_t index, double height);
+  // Curbs stop colliding: the walker passes through them (a training curriculum).
+  void make_curbs_ghosts();
   // Counts obstacles newly passed this step (in course order); returns how many.
   int update_passed();
   void observe(float* obs) const override;
@@ -105,6 +114,13 @@ class WalkerJump : public WalkerObstacleEnv {
     // still shows what follows a crossing, and a clean crossing is worth the bonuses more
     // than a touched one; the reference task ends on the first touch.
     bool contact_ends = true;
+    // true (training only): curbs do not collide. A walker geom reaching into a curb's
+    // box counts as touching it (contact_penalty, the curb's bonuses forfeit, the episode
+    // ends if contact_ends) and costs ghost_depth_cost per metre of depth (summed over the
+    // walker's geoms) each step. A foot that is too low then costs in proportion to how
+    // much too low it is, instead of tripping the walker.
+    bool ghost_curbs = false;
+    double ghost_depth_cost = 0.0;
   };
   WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
 
@@ -121,6 +137,9 @@ class WalkerJump : public WalkerObstacleEnv {
   // How far the bottom of `foot` (a body id) is above the ground, as a fraction of the
   // curb's height, in [0, 1].
   double clearance(int foot, double height) const;
+  // Summed depth of the walker's capsules in the curb's box (capsule_depth_in_box).
+  double depth_in_curb(const Obstacle& c, double height) const;
+  std::vector<int> walker_capsules_;
 
   Config jcfg_;
   int crossed_ = 0;              // marks (start, centre, end of each curb) the trailing foot has crossed

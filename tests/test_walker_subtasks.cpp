@@ -136,6 +136,57 @@ TEST(WalkerJump, TouchingGoesOnButForfeitsTheCurbWithContactEndsFalse) {
   EXPECT_NEAR(reward[1] - reward[0], 3 * 10.0, 1e-6);
 }
 
+TEST(WalkerJump, CapsuleDepthInACurbMatchesHandComputedValues) {
+  // Curb [-0.1, 0.1] x [0, 0.4]. Inside, the signed distance is minus the distance to the
+  // nearest face; outside, the distance to the box.
+  // A shin (r 0.04) standing in it from z 0.1 up: nearest face 0.1 away, depth 0.14.
+  EXPECT_NEAR(capsule_depth_in_box({0.0, 0.1}, {0.0, 0.6}, 0.04, -0.1, 0.1, 0.4), 0.14, 1e-12);
+  // A foot (r 0.06) lying across its top at z 0.45 grazes it by 0.01; at 0.5 it is clear.
+  EXPECT_NEAR(capsule_depth_in_box({-0.2, 0.45}, {0.2, 0.45}, 0.06, -0.1, 0.1, 0.4), 0.01, 1e-12);
+  EXPECT_EQ(capsule_depth_in_box({-0.2, 0.5}, {0.2, 0.5}, 0.06, -0.1, 0.1, 0.4), 0.0);
+  // Beside its face, 0.03 away: a 0.04 capsule reaches 0.01 in.
+  EXPECT_NEAR(capsule_depth_in_box({0.13, 0.1}, {0.13, 0.3}, 0.04, -0.1, 0.1, 0.4), 0.01, 1e-12);
+  // Off its top corner by (0.03, 0.04), 0.05 away: a 0.06 capsule reaches 0.01 in.
+  EXPECT_NEAR(capsule_depth_in_box({0.13, 0.44}, {0.13, 0.44}, 0.06, -0.1, 0.1, 0.4), 0.01, 1e-12);
+}
+
+TEST(WalkerJump, GhostCurbsLetTheWalkerThroughButChargeTheDepthAndForfeitTheCurb) {
+  // ghost_curbs: the curb makes no MuJoCo contact, the feet overlapping its start (as in
+  // the touch tests) cost ghost_depth_cost x their summed depth, and the curb can no
+  // longer count as a success. Twin envs differ only in the cost.
+  const std::string opts = "{curb_noise: 0, push_prob: 0, contact_ends: false, ghost_curbs: true, ghost_depth_cost: ";
+  auto charged = make_task("walker_jump", opts + "100}"), free = make_task("walker_jump", opts + "0}");
+  std::vector<float> obs(28);
+  double reward[2];
+  for (int e = 0; e < 2; ++e) {
+    Env& env = e == 0 ? *charged : *free;
+    env.reset(2, obs.data());
+    shift_x(env, 6.9, obs);
+    StepResult r = env.step(kZero, obs.data());
+    EXPECT_FALSE(r.terminated);
+    EXPECT_FALSE(dynamic_cast<WalkerObstacleEnv&>(env).touching()) << "a ghost curb makes no contact";
+    reward[e] = r.reward;
+  }
+  // The depth, summed over the walker's capsules in the pose the step ended in.
+  auto& m = dynamic_cast<MujocoEnv&>(*charged);
+  const mjModel* mod = m.model();
+  const mjData* d = m.data();
+  double depth = 0.0;
+  for (int g = 0; g < mod->ngeom; ++g) {
+    if (mod->geom_bodyid[g] == 0) continue;
+    const double* p = d->geom_xpos + 3 * g;
+    const double h = mod->geom_size[3 * g + 1], zx = d->geom_xmat[9 * g + 2], zz = d->geom_xmat[9 * g + 8];
+    depth += capsule_depth_in_box({p[0] - h * zx, p[2] - h * zz}, {p[0] + h * zx, p[2] + h * zz},
+                                  mod->geom_size[3 * g], 7.0, 7.2, 0.4);
+  }
+  EXPECT_GT(depth, 0.05);
+  EXPECT_NEAR(reward[1] - reward[0], 100.0 * depth, 1e-6);
+  shift_x(*charged, 7.2 + 1.5 + 0.05, obs);
+  StepResult r = charged->step(kZero, obs.data());
+  EXPECT_EQ(r.info.success_count, 1);
+  EXPECT_FALSE(r.info.success) << "a curb the walker reached into is no success";
+}
+
 TEST(WalkerJump, EpisodeEndsPastX15) {
   auto env = make_task("walker_jump", "{curb_noise: 0, push_prob: 0}");
   std::vector<float> obs(28);
