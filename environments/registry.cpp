@@ -50,6 +50,15 @@ Factory walker_jump(const std::string& name, const Section& env) {
   j.mark_upward_weight = env.get("mark_upward_weight", j.mark_upward_weight);
   j.ghost_curbs = env.get("ghost_curbs", j.ghost_curbs);
   j.ghost_depth_cost = env.get("ghost_depth_cost", j.ghost_depth_cost);
+  j.takeoff_bonus = env.get("takeoff_bonus", j.takeoff_bonus);
+  j.close_stance_cost = env.get("close_stance_cost", j.close_stance_cost);
+  j.stance_height = env.get("stance_height", j.stance_height);
+  if (env.has("takeoff_zone")) {
+    const auto zone = env.get("takeoff_zone", std::vector<double>());
+    if (zone.size() != 2 || !(zone[0] < zone[1]) || zone[1] > 0)
+      throw env.error("takeoff_zone", "must be [low, high] with low < high <= 0 (metres before the curb)");
+    j.takeoff_zone = {zone[0], zone[1]};
+  }
   if (j.curbs < 1) throw env.error("curbs", "must be at least 1");
   if (j.curbs > 1 && j.curb_spacing <= 2 * j.curb_noise + o.curb_width)
     throw env.error("curb_spacing", "must exceed 2 curb_noise + curb_width so curbs do not overlap");

@@ -186,7 +186,7 @@ void WalkerJump::reset_task() {
   }
   set_obstacles(layout);
   for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
-  crossed_ = 0, touched_ = 0;
+  crossed_ = 0, touched_ = 0, took_off_ = 0;
   peak_curb_ = -1, peak_ = 0.0;
   WalkerEnv::reset_task();
 }
@@ -223,6 +223,14 @@ StepResult WalkerJump::evaluate(const float* action) {
       const double rise = lower * heights_[next] - peak_;
       if (rise > 0) r.reward += jcfg_.peak_weight * rise, peak_ += rise;
     }
+    for (int f : {foot_, foot_left_}) {
+      if (data_->xpos[3 * f + 2] > jcfg_.stance_height) continue;
+      const double at = data_->xpos[3 * f] - curb.start;
+      if (at >= jcfg_.takeoff_zone[0] && at <= jcfg_.takeoff_zone[1] && !(took_off_ >> next & 1u))
+        r.reward += jcfg_.takeoff_bonus, took_off_ |= 1u << next;
+      else if (at > jcfg_.takeoff_zone[1] && at < 0.0)
+        r.reward -= jcfg_.close_stance_cost;
+    }
   }
   bool contact = false;
   if (jcfg_.ghost_curbs) {
@@ -252,6 +260,7 @@ void WalkerJump::save_extra(std::vector<double>& out) const {
   out.push_back(peak_curb_);
   out.push_back(peak_);
   out.push_back(touched_);
+  out.push_back(took_off_);
   out.insert(out.end(), heights_.begin(), heights_.end());
 }
 void WalkerJump::restore_extra(const double* in, size_t n) {
@@ -259,8 +268,9 @@ void WalkerJump::restore_extra(const double* in, size_t n) {
   peak_curb_ = n > 1 ? int(in[1]) : -1;
   peak_ = n > 2 ? in[2] : 0.0;
   touched_ = n > 3 ? uint32_t(in[3]) : 0u;
+  took_off_ = n > 4 ? uint32_t(in[4]) : 0u;
   heights_.assign(obstacles_.size(), jcfg_.curb_height);
-  for (size_t k = 0; k + 4 < n && k < heights_.size(); ++k) heights_[k] = in[4 + k];
+  for (size_t k = 0; k + 5 < n && k < heights_.size(); ++k) heights_[k] = in[5 + k];
   for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
 }
 

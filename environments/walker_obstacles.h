@@ -121,6 +121,16 @@ class WalkerJump : public WalkerObstacleEnv {
     // much too low it is, instead of tripping the walker.
     bool ghost_curbs = false;
     double ghost_depth_cost = 0.0;
+    // Take-off shaping (training only). A foot is in stance when its ankle is within
+    // stance_height of the floor; x is its ankle relative to the next curb's start.
+    // + takeoff_bonus once per curb for a stance with x in takeoff_zone, the stretch a
+    // clearing jump starts from; - close_stance_cost each step a foot stands between the
+    // zone and the curb, too close to clear it. Stage 3's hop clears the curb exactly
+    // when its last stance is in [-1.23, -0.59] and touches it from every other (the
+    // README's jump notes: probe_jump_failures): it does not place its take-off.
+    double takeoff_bonus = 0.0, close_stance_cost = 0.0;
+    std::array<double, 2> takeoff_zone = {-1.2, -0.6};
+    double stance_height = 0.08;
   };
   WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
 
@@ -144,6 +154,7 @@ class WalkerJump : public WalkerObstacleEnv {
   Config jcfg_;
   int crossed_ = 0;              // marks (start, centre, end of each curb) the trailing foot has crossed
   uint32_t touched_ = 0;         // bit k: curb k was touched (only with contact_ends false)
+  uint32_t took_off_ = 0;        // bit k: curb k's takeoff_bonus was paid
   int peak_curb_ = -1;           // the curb peak_ belongs to
   double peak_ = 0.0;            // highest lower-foot clearance (m) in that curb's window so far
   std::vector<double> heights_;  // per curb

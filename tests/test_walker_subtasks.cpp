@@ -187,6 +187,43 @@ TEST(WalkerJump, GhostCurbsLetTheWalkerThroughButChargeTheDepthAndForfeitTheCurb
   EXPECT_FALSE(r.info.success) << "a curb the walker reached into is no success";
 }
 
+TEST(WalkerJump, TakeoffShapingPaysAStanceInTheZoneOnceAndChargesOneTooClose) {
+  // The curb starts at 7.0 (no noise). The walker stands with both ankles on the floor
+  // at x - 7.0 = `at`; twin envs differ only in takeoff_bonus and close_stance_cost.
+  auto step_rewards = [](double at, const std::string& shaping) {
+    auto env = make_task("walker_jump", "{curb_noise: 0, push_prob: 0, init_random_steps: 0, init_noise: 0" + shaping + "}");
+    std::vector<float> obs(28);
+    env->reset(0, obs.data());
+    auto& m = dynamic_cast<MujocoEnv&>(*env);
+    const int f1 = mj_name2id(m.model(), mjOBJ_BODY, "foot"), f2 = mj_name2id(m.model(), mjOBJ_BODY, "foot_left");
+    shift_x(*env, 0.0, obs);
+    const double ankle_offset = m.data()->xpos[3 * f1];  // the ankles' x in the standing pose
+    m.mutable_data()->qpos[1] -= m.data()->xpos[3 * f1 + 2] - 0.06;  // lowered onto its feet (radius 0.06)
+    shift_x(*env, 7.0 + at - ankle_offset, obs);
+    std::vector<double> rewards;
+    for (int t = 0; t < 2; ++t) {
+      rewards.push_back(env->step(kZero, obs.data()).reward);
+      for (int f : {f1, f2}) {
+        EXPECT_LE(m.data()->xpos[3 * f + 2], 0.08) << "both feet stand";
+        EXPECT_NEAR(m.data()->xpos[3 * f] - 7.0, at, 0.05);
+      }
+    }
+    return rewards;
+  };
+  const std::string shaping = ", takeoff_bonus: 100, close_stance_cost: 10, takeoff_zone: [-1.2, -0.6]";
+  // In the zone: the bonus once, on the first step only (both feet there).
+  auto plain = step_rewards(-0.9, ""), shaped = step_rewards(-0.9, shaping);
+  EXPECT_NEAR(shaped[0] - plain[0], 100.0, 1e-6);
+  EXPECT_NEAR(shaped[1] - plain[1], 0.0, 1e-6);
+  // Between the zone and the curb: 10 for each foot, every step.
+  plain = step_rewards(-0.4, ""), shaped = step_rewards(-0.4, shaping);
+  EXPECT_NEAR(shaped[0] - plain[0], -20.0, 1e-6);
+  EXPECT_NEAR(shaped[1] - plain[1], -20.0, 1e-6);
+  // Farther back than the zone: nothing.
+  plain = step_rewards(-2.0, ""), shaped = step_rewards(-2.0, shaping);
+  EXPECT_NEAR(shaped[0] - plain[0], 0.0, 1e-6);
+}
+
 TEST(WalkerJump, EpisodeEndsPastX15) {
   auto env = make_task("walker_jump", "{curb_noise: 0, push_prob: 0}");
   std::vector<float> obs(28);

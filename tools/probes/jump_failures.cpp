@@ -6,6 +6,7 @@
 // usage: build/probe_jump_failures POLICY N SEED [key=value ...]  (env keys, e.g. curb_height=0.2)
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
@@ -39,17 +40,35 @@ int main(int argc, char** argv) {
   const uint64_t seed = std::strtoull(argv[3], nullptr, 10);
   const mjModel* m = mj->model();
   const int floor = mj_name2id(m, mjOBJ_GEOM, "floor");
+  const int curb0 = mj_name2id(m, mjOBJ_GEOM, "curb0");
   std::map<std::string, int> ends;
   std::vector<float> obs(env->spec().obs_dim), act(env->spec().act_dim);
   for (int e = 0; e < n; ++e) {
     env->reset(seed + e, obs.data());
     int steps = 0;
+    double deepest = 0.0;  // the walker's summed depth in the curb (nonzero only with ghost curbs)
     for (;;) {
       pi.act(obs.data(), 1, act.data());
       StepResult r = env->step(act.data(), obs.data());
       ++steps;
-      if (!r.done()) continue;
       const mjData* d = mj->data();
+      const Obstacle& curb = walker->obstacles()[0];
+      double depth = 0.0;
+      for (int g = 0; g < m->ngeom; ++g) {
+        if (m->geom_bodyid[g] == 0) continue;
+        const double* p = d->geom_xpos + 3 * g;
+        const double h = m->geom_size[3 * g + 1], zx = d->geom_xmat[9 * g + 2], zz = d->geom_xmat[9 * g + 8];
+        depth += capsule_depth_in_box({p[0] - h * zx, p[2] - h * zz}, {p[0] + h * zx, p[2] + h * zz},
+                                      m->geom_size[3 * g], curb.start, curb.end, 2 * m->geom_size[3 * curb0 + 2]);
+      }
+      deepest = std::max(deepest, depth);
+      if (std::getenv("TRACE") && d->qpos[0] > curb.start - 2.0) {
+        const int f1 = mj_name2id(m, mjOBJ_BODY, "foot"), f2 = mj_name2id(m, mjOBJ_BODY, "foot_left");
+        std::printf("  x-start %+.2f torso z %.2f  foot (%+.2f, %.2f)  foot_left (%+.2f, %.2f)\n", d->qpos[0] - curb.start,
+                    d->qpos[1], d->xpos[3 * f1] - curb.start, d->xpos[3 * f1 + 2], d->xpos[3 * f2] - curb.start,
+                    d->xpos[3 * f2 + 2]);
+      }
+      if (!r.done()) continue;
       std::string why;
       if (r.info.success) why = "success";
       else if (r.truncated) why = "time limit";
@@ -67,8 +86,8 @@ int main(int argc, char** argv) {
         if (why.empty()) why = "touched earlier (contact_ends false)";
       }
       ++ends[why];
-      std::printf("episode %d: %s after %d steps, torso x %.2f, obs start-x %.2f\n", e, why.c_str(), steps,
-                  d->qpos[0], obs[26]);
+      std::printf("episode %d: %s after %d steps, torso x %.2f, obs start-x %.2f, deepest %.3f\n", e, why.c_str(),
+                  steps, d->qpos[0], obs[26], deepest);
       break;
     }
   }
