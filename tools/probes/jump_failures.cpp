@@ -1,16 +1,19 @@
 // Developer probe (not part of `segue`): how a jump policy's episodes end on the
 // reference jump task. For each episode: success, fall or curb contact; for a contact,
 // which geom touched and where the walker was; the highest both feet were off the ground
-// before the curb.
+// before the curb, and where its last two-footed stance before the curb was (mean ankle x
+// minus the curb's start): the take-off point of a hop.
 // Build: cmake --build build --target probe_jump_failures
 // usage: build/probe_jump_failures POLICY N SEED [key=value ...]  (env keys, e.g. curb_height=0.2)
 #include <mujoco/mujoco.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "algorithms/policy.h"
 #include "core/mujoco_env.h"
@@ -41,12 +44,15 @@ int main(int argc, char** argv) {
   const mjModel* m = mj->model();
   const int floor = mj_name2id(m, mjOBJ_GEOM, "floor");
   const int curb0 = mj_name2id(m, mjOBJ_GEOM, "curb0");
+  const int f1 = mj_name2id(m, mjOBJ_BODY, "foot"), f2 = mj_name2id(m, mjOBJ_BODY, "foot_left");
+  std::map<std::string, std::vector<double>> stances;  // outcome -> last stances
   std::map<std::string, int> ends;
   std::vector<float> obs(env->spec().obs_dim), act(env->spec().act_dim);
   for (int e = 0; e < n; ++e) {
     env->reset(seed + e, obs.data());
     int steps = 0;
     double deepest = 0.0;  // the walker's summed depth in the curb (nonzero only with ghost curbs)
+    double last_stance = NAN;
     for (;;) {
       pi.act(obs.data(), 1, act.data());
       StepResult r = env->step(act.data(), obs.data());
@@ -62,8 +68,9 @@ int main(int argc, char** argv) {
                                       m->geom_size[3 * g], curb.start, curb.end, 2 * m->geom_size[3 * curb0 + 2]);
       }
       deepest = std::max(deepest, depth);
+      const double a1 = d->xpos[3 * f1] - curb.start, a2 = d->xpos[3 * f2] - curb.start;
+      if (d->xpos[3 * f1 + 2] < 0.07 && d->xpos[3 * f2 + 2] < 0.07 && std::max(a1, a2) < 0) last_stance = 0.5 * (a1 + a2);
       if (std::getenv("TRACE") && d->qpos[0] > curb.start - 2.0) {
-        const int f1 = mj_name2id(m, mjOBJ_BODY, "foot"), f2 = mj_name2id(m, mjOBJ_BODY, "foot_left");
         std::printf("  x-start %+.2f torso z %.2f  foot (%+.2f, %.2f)  foot_left (%+.2f, %.2f)\n", d->qpos[0] - curb.start,
                     d->qpos[1], d->xpos[3 * f1] - curb.start, d->xpos[3 * f1 + 2], d->xpos[3 * f2] - curb.start,
                     d->xpos[3 * f2 + 2]);
@@ -86,10 +93,18 @@ int main(int argc, char** argv) {
         if (why.empty()) why = "touched earlier (contact_ends false)";
       }
       ++ends[why];
-      std::printf("episode %d: %s after %d steps, torso x %.2f, obs start-x %.2f, deepest %.3f\n", e, why.c_str(),
-                  steps, d->qpos[0], obs[26], deepest);
+      const std::string outcome = why.substr(0, why.find_first_of(" ,"));
+      if (!std::isnan(last_stance)) stances[outcome].push_back(last_stance);
+      std::printf("episode %d: %s after %d steps, torso x %.2f, obs start-x %.2f, deepest %.3f, last stance %.2f\n",
+                  e, why.c_str(), steps, d->qpos[0], obs[26], deepest, last_stance);
       break;
     }
+  }
+  for (auto& kv : stances) {
+    std::sort(kv.second.begin(), kv.second.end());
+    std::printf("last stance before the curb, %s:", kv.first.c_str());
+    for (double x : kv.second) std::printf(" %.2f", x);
+    std::printf("\n");
   }
   for (auto& kv : ends) std::printf("%-32s %d\n", kv.first.c_str(), kv.second);
 }
