@@ -158,13 +158,14 @@ void WalkerObstacleEnv::restore_task_state(const double* in, size_t n) {
 
 WalkerJump::WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c)
     : WalkerObstacleEnv(name, w, o, true), jcfg_(c) {
-  if (!jcfg_.ghost_curbs) return;
-  make_curbs_ghosts();
+  if (jcfg_.ghost_curbs) make_curbs_ghosts();
   for (int g = 0; g < model_->ngeom; ++g)
     if (model_->geom_bodyid[g] != 0 && model_->geom_type[g] == mjGEOM_CAPSULE) walker_capsules_.push_back(g);
 }
 
-double WalkerJump::depth_in_curb(const Obstacle& c, double height) const {
+double WalkerJump::depth_in_curb(size_t k) const {
+  const Obstacle& c = obstacles_.at(k);
+  const double height = heights_.at(k);
   double depth = 0.0;
   for (int g : walker_capsules_) {
     const double* p = &data_->geom_xpos[3 * g];
@@ -236,7 +237,7 @@ StepResult WalkerJump::evaluate(const float* action) {
   if (jcfg_.ghost_curbs) {
     for (size_t k = 0; k < obstacles_.size(); ++k) {
       if (std::abs(obstacles_[k].start - torso_x()) > 2.0) continue;  // out of the walker's reach
-      const double depth = depth_in_curb(obstacles_[k], heights_[k]);
+      const double depth = depth_in_curb(k);
       if (depth <= 0) continue;
       contact = true, touched_ |= 1u << k;
       r.reward -= jcfg_.ghost_depth_cost * depth;

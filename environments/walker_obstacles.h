@@ -133,6 +133,9 @@ class WalkerJump : public WalkerObstacleEnv {
     double stance_height = 0.08;
   };
   WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
+  // Summed depth of the walker's capsules in curb k's box (capsule_depth_in_box): what
+  // ghost curbs charge; with solid curbs MuJoCo keeps it near 0.
+  double depth_in_curb(size_t k) const;
 
  protected:
   void reset_task() override;
@@ -147,8 +150,6 @@ class WalkerJump : public WalkerObstacleEnv {
   // How far the bottom of `foot` (a body id) is above the ground, as a fraction of the
   // curb's height, in [0, 1].
   double clearance(int foot, double height) const;
-  // Summed depth of the walker's capsules in the curb's box (capsule_depth_in_box).
-  double depth_in_curb(const Obstacle& c, double height) const;
   std::vector<int> walker_capsules_;
 
   Config jcfg_;

@@ -36,14 +36,13 @@ int main(int argc, char** argv) {
   }
   yaml += "}";
   auto env = task_factory("walker_jump", Recipe::parse(yaml, "probe").root())();
-  auto* walker = dynamic_cast<WalkerObstacleEnv*>(env.get());
+  auto* walker = dynamic_cast<WalkerJump*>(env.get());
   const MujocoEnv* mj = walker;
   const Policy pi = Policy::load(argv[1]);
   const int n = std::atoi(argv[2]);
   const uint64_t seed = std::strtoull(argv[3], nullptr, 10);
   const mjModel* m = mj->model();
   const int floor = mj_name2id(m, mjOBJ_GEOM, "floor");
-  const int curb0 = mj_name2id(m, mjOBJ_GEOM, "curb0");
   const int f1 = mj_name2id(m, mjOBJ_BODY, "foot"), f2 = mj_name2id(m, mjOBJ_BODY, "foot_left");
   std::map<std::string, std::vector<double>> stances;  // outcome -> last stances
   std::map<std::string, int> ends;
@@ -59,14 +58,7 @@ int main(int argc, char** argv) {
       ++steps;
       const mjData* d = mj->data();
       const Obstacle& curb = walker->obstacles()[0];
-      double depth = 0.0;
-      for (int g = 0; g < m->ngeom; ++g) {
-        if (m->geom_bodyid[g] == 0) continue;
-        const double* p = d->geom_xpos + 3 * g;
-        const double h = m->geom_size[3 * g + 1], zx = d->geom_xmat[9 * g + 2], zz = d->geom_xmat[9 * g + 8];
-        depth += capsule_depth_in_box({p[0] - h * zx, p[2] - h * zz}, {p[0] + h * zx, p[2] + h * zz},
-                                      m->geom_size[3 * g], curb.start, curb.end, 2 * m->geom_size[3 * curb0 + 2]);
-      }
+      const double depth = walker->depth_in_curb(0);
       deepest = std::max(deepest, depth);
       const double a1 = d->xpos[3 * f1] - curb.start, a2 = d->xpos[3 * f2] - curb.start;
       if (d->xpos[3 * f1 + 2] < 0.07 && d->xpos[3 * f2 + 2] < 0.07 && std::max(a1, a2) < 0) last_stance = 0.5 * (a1 + a2);
