@@ -150,7 +150,7 @@ class WalkerJump : public WalkerObstacleEnv {
   // How far the bottom of `foot` (a body id) is above the ground, as a fraction of the
   // curb's height, in [0, 1].
   double clearance(int foot, double height) const;
-  std::vector<int> walker_capsules_;
+  std::vector<int> walker_capsules_;  // the walker's geoms (all capsules), for depth_in_curb
 
   Config jcfg_;
   int crossed_ = 0;              // marks (start, centre, end of each curb) the trailing foot has crossed

@@ -1,8 +1,9 @@
 // Developer probe (not part of `segue`): how a jump policy's episodes end on the
 // reference jump task. For each episode: success, fall or curb contact; for a contact,
-// which geom touched and where the walker was; the highest both feet were off the ground
-// before the curb, and where its last two-footed stance before the curb was (mean ankle x
-// minus the curb's start): the take-off point of a hop.
+// which geom touched and where the walker was; how deep it reached into the curb (with
+// ghost_curbs=true); and where its last two-footed stance before the curb was (mean ankle
+// x minus the curb's start): the take-off point of a hop. TRACE=1 prints every step near
+// the curb.
 // Build: cmake --build build --target probe_jump_failures
 // usage: build/probe_jump_failures POLICY N SEED [key=value ...]  (env keys, e.g. curb_height=0.2)
 #include <mujoco/mujoco.h>
