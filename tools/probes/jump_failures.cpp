@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,14 +30,16 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: %s POLICY N SEED [key=value ...]\n", argv[0]);
     return 2;
   }
-  std::string yaml = "{";
-  for (int i = 4; i < argc; ++i) {
-    std::string kv = argv[i];
-    auto eq = kv.find('=');
-    yaml += (i > 4 ? ", " : "") + kv.substr(0, eq) + ": " + kv.substr(eq + 1);
+  // The env keys, as `segue --set` overrides of an empty task section.
+  std::unique_ptr<Env> env;
+  try {
+    const Recipe settings = Recipe::parse("{}", "probe", std::vector<std::string>(argv + 4, argv + argc));
+    env = task_factory("walker_jump", settings.root())();
+    settings.reject_unknown();
+  } catch (const Error& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
   }
-  yaml += "}";
-  auto env = task_factory("walker_jump", Recipe::parse(yaml, "probe").root())();
   auto* walker = dynamic_cast<WalkerJump*>(env.get());
   const MujocoEnv* mj = walker;
   const Policy pi = Policy::load(argv[1]);
