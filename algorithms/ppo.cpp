@@ -25,6 +25,7 @@ PpoConfig PpoConfig::read(const Section& s, PpoConfig c) {
   c.vf_coef = s.get("vf_coef", c.vf_coef);
   c.ent_coef = s.get("ent_coef", c.ent_coef);
   c.min_log_std = s.get("min_log_std", c.min_log_std);
+  c.noise_repeat = s.get("noise_repeat", c.noise_repeat);
   c.max_grad_norm = s.get("max_grad_norm", c.max_grad_norm);
   c.normalize_reward = s.get("normalize_reward", c.normalize_reward);
   c.obs_clip = s.get("obs_clip", c.obs_clip);
@@ -32,6 +33,7 @@ PpoConfig PpoConfig::read(const Section& s, PpoConfig c) {
   if (c.steps_per_env <= 0) throw s.error("steps_per_env", "must be positive");
   if (c.minibatch_size <= 0) throw s.error("minibatch_size", "must be positive");
   if (c.epochs <= 0) throw s.error("epochs", "must be positive");
+  if (c.noise_repeat <= 0) throw s.error("noise_repeat", "must be positive");
   if (!(c.lr > 0)) throw s.error("lr", "must be positive");
   if (!(c.gamma > 0 && c.gamma <= 1)) throw s.error("gamma", "must be in (0, 1]");
   if (!(c.lambda >= 0 && c.lambda <= 1)) throw s.error("lambda", "must be in [0, 1]");
@@ -48,6 +50,8 @@ PPO::PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, u
   buf_.resize(cfg_.steps_per_env, envs.size(), net.obs_dim, net.act_dim);
   running_return_.assign(envs.size(), 0.0);
   mean_.resize(size_t(envs.size()) * net.act_dim);
+  noise_.resize(size_t(envs.size()) * net.act_dim);
+  noise_age_.assign(envs.size(), 0);
   envs_.reset(mix_seed(seed, 0));
   refresh_inference_copy();
 }
@@ -96,7 +100,10 @@ void PPO::sample_actions(int t) {
   for (int i = 0; i < N; ++i) {
     float* a = act + size_t(i) * A;
     const float* mu = &mean_[size_t(i) * A];
-    for (int j = 0; j < A; ++j) a[j] = mu[j] + std::exp(log_std_[j]) * static_cast<float>(rng_.normal());
+    float* eps = &noise_[size_t(i) * A];
+    if (noise_age_[i]++ % cfg_.noise_repeat == 0)
+      for (int j = 0; j < A; ++j) eps[j] = static_cast<float>(rng_.normal());
+    for (int j = 0; j < A; ++j) a[j] = mu[j] + std::exp(log_std_[j]) * eps[j];
     buf_.log_probs[size_t(t) * N + i] = static_cast<float>(gaussian_log_prob(a, mu, log_std_.data(), A));
   }
 }
@@ -121,6 +128,7 @@ void PPO::collect_rollout(IterationStats& stats) {
                   buf_.next_raw_obs_at(t) + size_t(i) * D);
       buf_.raw_rewards[k] = envs_.reward()[i];
       buf_.dones[k] = envs_.terminated()[i] || envs_.truncated()[i];
+      if (buf_.dones[k]) noise_age_[i] = 0;
       if (envs_.truncated()[i] && !envs_.terminated()[i]) {
         buf_.truncated_index.push_back(static_cast<int>(k));
         buf_.truncated_obs.resize(buf_.truncated_obs.size() + D);

@@ -35,6 +35,11 @@ struct PpoConfig {
   // entropy bonus at these scales (ent_coef 0.01 blew the std up on the jump, 0.003 did
   // not stop it falling to 0.04), so a continued run may need exploration held open.
   double min_log_std = -20.0;       // -20: no floor
+  // Exploration noise held for this many steps before it is redrawn (as gSDE redraws its
+  // noise every n steps; Raffin et al. 2022). Independent noise each step averages out
+  // over a stance, so a gait's step length is never explored; noise held over a push-off
+  // changes it. Each action's marginal is still N(mu, sigma), which PPO's ratio uses.
+  int noise_repeat = 1;
   double max_grad_norm = 0.5;
   bool normalize_reward = true;     // scale rewards by the std of the discounted return
   double obs_clip = 10.0;
@@ -116,6 +121,8 @@ class PPO {
   uint64_t seed_;
   std::vector<double> running_return_;  // discounted return per env, for reward scaling
   std::vector<float> mean_, log_std_;
+  std::vector<float> noise_;       // the standard normal draw each env's action adds [N, A]
+  std::vector<int> noise_age_;     // steps since that draw, reset when an episode ends
   RewardHook reward_hook_;
   int64_t iteration_ = 0, global_step_ = 0;
   double wall_seconds_ = 0.0;

@@ -100,6 +100,7 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run("train " + (dir_ / "missing.yaml").string()), "missing.yaml: cannot read recipe");
   auto ok = write("ok.yaml", "task: walker_forward\n");
   expect_one_line_error(run("train " + ok + " --set ppo.lrr=1"), "unknown key 'ppo.lrr' (from --set)");
+  expect_one_line_error(run("train " + ok + " --set ppo.noise_repeat=0"), "key 'ppo.noise_repeat': must be positive");
   auto zone = write("zone.yaml", "task: walker_jump\nenv: {takeoff_zone: [-0.6, -1.2]}\n");
   expect_one_line_error(run("train " + zone), "zone.yaml: key 'env.takeoff_zone': must be [low, high] with low < high <= 0");
   auto std_alone = write("std.yaml", "task: walker_forward\ninit_log_std: -1\n");
