@@ -217,6 +217,8 @@ void Recipe::reject_unknown() const {
   }
 }
 
+const std::set<std::string>& Recipe::defaulted_keys() const { return s_->defaulted; }
+
 std::string Recipe::resolved_yaml() const {
   YAML::Emitter e;
   e.SetDoublePrecision(15);  // 0.2, not 0.20000000000000001

@@ -62,6 +62,8 @@ class Recipe {
   void reject_unknown() const;
   // The values read so far, defaults included, as YAML text.
   std::string resolved_yaml() const;
+  // The keys among them that the recipe left to their defaults ("ppo.noise_repeat").
+  const std::set<std::string>& defaulted_keys() const;
 
  private:
   explicit Recipe(std::shared_ptr<Section::State> s) : s_(std::move(s)) {}
@@ -74,6 +76,7 @@ struct Section::State {
   YAML::Node resolved;
   std::set<std::string> read;
   std::set<std::string> overridden;
+  std::set<std::string> defaulted;  // keys read whose value is the code's default
 };
 
 template <class T>
@@ -81,6 +84,7 @@ T Section::get(const std::string& key, const T& fallback) const {
   std::string k = full(key);
   auto node = lookup(k);
   T value = node ? convert<T>(*node, k) : fallback;
+  if (!node) s_->defaulted.insert(k);
   record(k, YAML::Node(value));
   return value;
 }

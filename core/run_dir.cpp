@@ -5,7 +5,10 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <sstream>
+
+#include <yaml-cpp/yaml.h>
 
 #include "core/error.h"
 
@@ -62,27 +65,57 @@ void MetricsCsv::write(const std::vector<double>& values) {
 }
 
 namespace {
-// The recipe without its top-level `threads:` line: the thread count does not change
-// what a run computes, so a run may resume with another one.
-std::string without_threads(const std::string& yaml) {
-  std::stringstream in(yaml);
-  std::string out;
-  for (std::string line; std::getline(in, line);)
-    if (line.rfind("threads:", 0) != 0) out += line + "\n";
+// Every leaf of a YAML tree by its dotted path ("ppo.lr", "policy.pi_hidden.0"), as text.
+void flatten(const YAML::Node& node, const std::string& path, std::map<std::string, std::string>& out) {
+  auto child = [&](const std::string& key) { return path.empty() ? key : path + "." + key; };
+  if (node.IsMap()) {
+    for (const auto& kv : node) flatten(kv.second, child(kv.first.Scalar()), out);
+  } else if (node.IsSequence()) {
+    for (size_t i = 0; i < node.size(); ++i) flatten(node[i], child(std::to_string(i)), out);
+    if (node.size() == 0) out[path] = "[]";
+  } else {
+    out[path] = node.IsScalar() ? node.Scalar() : "~";
+  }
+}
+
+std::map<std::string, std::string> leaves(const std::string& yaml, const std::string& file) {
+  std::map<std::string, std::string> out;
+  try {
+    flatten(YAML::Load(yaml), "", out);
+  } catch (const YAML::Exception& e) {
+    throw Error(file + ": unreadable recipe (" + e.msg + ")");
+  }
+  out.erase("threads");  // the thread count does not change what a run computes
   return out;
 }
 }  // namespace
 
-RunDir::RunDir(const std::string& dir, const std::string& resolved) : dir_(dir) {
+RunDir::RunDir(const std::string& dir, const std::string& resolved,
+               const std::set<std::string>& defaulted)
+    : dir_(dir) {
   fs::create_directories(dir);
   std::string recipe = file("recipe.yaml");
-  if (fs::exists(recipe)) {
-    if (without_threads(read_file(recipe)) != without_threads(resolved))
-      throw Error(recipe + ": this run directory was started with a different recipe; "
-                  "choose another run_dir or remove the directory");
-  } else {
+  if (!fs::exists(recipe)) {
     write_file_atomic(recipe, resolved);
+    return;
   }
+  auto then = leaves(read_file(recipe), recipe), now = leaves(resolved, recipe);
+  auto refuse = [&](const std::string& key, const std::string& was, const std::string& is) {
+    return Error(recipe + ": this run directory was started with a different recipe (key '" + key +
+                 "': " + was + " there, " + is + " now); choose another run_dir or remove the directory");
+  };
+  for (const auto& [key, value] : then) {
+    auto it = now.find(key);
+    if (it == now.end()) throw refuse(key, value, "absent");
+    if (it->second != value) throw refuse(key, value, it->second);
+  }
+  bool added = false;
+  for (const auto& [key, value] : now)
+    if (!then.count(key)) {
+      if (!defaulted.count(key)) throw refuse(key, "absent", value);
+      added = true;
+    }
+  if (added) write_file_atomic(recipe, resolved);
 }
 
 bool RunDir::has_checkpoint() const { return fs::exists(checkpoint()); }

@@ -3,6 +3,7 @@
 // iteration), and checkpoints. Files are replaced atomically (write, fsync, rename), so
 // a run killed at any moment leaves either the old checkpoint or the new one.
 #include <fstream>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -26,9 +27,13 @@ class MetricsCsv {
 
 class RunDir {
  public:
-  // Opens or creates DIR. A DIR holding a different resolved recipe is refused (the
-  // `threads` setting aside: it does not change results).
-  RunDir(const std::string& dir, const std::string& resolved_recipe);
+  // Opens or creates DIR. A DIR holding a different resolved recipe is refused, naming
+  // the first key that differs. Two differences are let through: `threads`, which does
+  // not change results; and a key the stored recipe lacks that `defaulted` holds, i.e. a
+  // setting added to the code since the run started and left at its default (the old
+  // behaviour). The run then resumes and the stored recipe is rewritten with the key.
+  RunDir(const std::string& dir, const std::string& resolved_recipe,
+         const std::set<std::string>& defaulted = {});
   const std::string& path() const { return dir_; }
   std::string file(const std::string& name) const { return dir_ + "/" + name; }
   std::string checkpoint() const { return file("checkpoint.pt"); }

@@ -36,6 +36,7 @@ CompositeRecipe CompositeRecipe::load(const std::string& file, const std::vector
   c.eval_seeds = ev.get("seeds", c.eval_seeds);
   recipe.reject_unknown();
   c.resolved = recipe.resolved_yaml();
+  c.defaulted = recipe.defaulted_keys();
   return c;
 }
 

@@ -17,6 +17,7 @@
 //     transitions: assets/policies/walker/hurdle   # NAME/policy.pt, q.pt per transition
 //   eval: {episodes: 50, seeds: [0, 1, 2]}
 //   ... and the pipeline's settings (hrl/pipeline_config.h).
+#include <set>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,7 @@ struct CompositeRecipe {
   std::string transitions_dir;  // methods.transitions ("" when absent)
   PipelineConfig pipeline;
   std::string resolved;         // the recipe as read, defaults included (for run dirs)
+  std::set<std::string> defaulted;  // its keys left at their defaults
   int eval_episodes = 50;
   std::vector<int> eval_seeds{0, 1, 2};
 

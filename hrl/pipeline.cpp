@@ -206,7 +206,7 @@ void write_actions(const CompositeRecipe& r, int t, const std::string& dir, int 
 
 int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
   const std::string run = recipe.pipeline.run_dir;
-  RunDir dir(run, recipe.resolved);
+  RunDir dir(run, recipe.resolved, recipe.defaulted);
   const int n = int(recipe.meta.transitions().size());
   const bool lee = recipe.pipeline.lee.enabled;
   const int stages = (lee ? 4 : 3) * n + 1;

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include "core/recipe.h"
 #include "tests/temp_dir.h"
@@ -22,8 +23,9 @@ TEST(Recipe, ReadsValuesDefaultsAndOverrides) {
   EXPECT_EQ(r.root().get("seed", 0), 3);
   EXPECT_DOUBLE_EQ(r.root().sub("env").get("push_prob", 0.2), 0.0);
   EXPECT_NO_THROW(r.reject_unknown());
-  // The resolved recipe records defaults too.
+  // The resolved recipe records defaults too, and which keys were left to them.
   EXPECT_NE(r.resolved_yaml().find("minibatch_size: 64"), std::string::npos);
+  EXPECT_EQ(r.defaulted_keys(), (std::set<std::string>{"ppo.minibatch_size"}));
 }
 
 TEST(Recipe, UnknownKeyIsNamedWithASuggestion) {

@@ -44,7 +44,7 @@ int train_main(int argc, char** argv) {
   // fixed thread count keeps floating-point sums, and so the trained policy, the same
   // whatever `threads` is. `threads` parallelises environment stepping only.
   set_torch_threads(1);
-  RunDir dir(s.run_dir, recipe.resolved_yaml());
+  RunDir dir(s.run_dir, recipe.resolved_yaml(), recipe.defaulted_keys());
   VectorEnv envs(s.make_env, s.ppo.num_envs, threads);
   PPO ppo(s.ppo, s.net, envs, s.seed);
   if (dir.has_checkpoint()) {
