@@ -60,6 +60,10 @@ int64_t PPO::total_iterations() const {
   return (cfg_.total_steps + cfg_.rollout_size() - 1) / cfg_.rollout_size();
 }
 
+double PPO::learning_rate() const {
+  return static_cast<const torch::optim::AdamOptions&>(optimizer_->param_groups().front().options()).lr();
+}
+
 void PPO::set_log_std(double log_std) {
   torch::NoGradGuard no_grad;
   net_->log_std.fill_(log_std);
@@ -191,7 +195,8 @@ void PPO::update(IterationStats& stats) {
   const int64_t M = int64_t(buf_.T) * buf_.N;
   const int64_t mb = std::min<int64_t>(cfg_.minibatch_size, M);
   if (cfg_.anneal_lr) {
-    double frac = 1.0 - double(iteration_) / double(total_iterations());
+    const double span = double(total_iterations() - schedule_start_);
+    double frac = span > 0 ? 1.0 - double(iteration_ - schedule_start_) / span : 0.0;
     for (auto& group : optimizer_->param_groups())
       static_cast<torch::optim::AdamOptions&>(group.options()).lr(cfg_.lr * std::max(frac, 0.0));
   }
@@ -323,7 +328,7 @@ void PPO::save(const std::string& path, const std::string& note, const ArchiveWr
   obs_rms_.save(ar, "obs_rms_");
   return_rms_.save(ar, "return_rms_");
   const auto& s = net_->spec;
-  ar.write("meta_counters", ints({iteration_, global_step_, int64_t(wall_seconds_ * 1000)}));
+  ar.write("meta_counters", ints({iteration_, global_step_, int64_t(wall_seconds_ * 1000), schedule_start_}));
   ar.write("meta_dims", ints({s.obs_dim, s.act_dim, s.activation == Activation::Tanh ? 0 : 1}));
   ar.write("meta_pi_hidden", ints(widen(s.pi_hidden)));
   ar.write("meta_vf_hidden", ints(widen(s.vf_hidden)));
@@ -361,6 +366,7 @@ void PPO::load(const std::string& path, const ArchiveReader& extra) {
   iteration_ = counters[0].item<int64_t>();
   global_step_ = counters[1].item<int64_t>();
   wall_seconds_ = counters[2].item<int64_t>() / 1000.0;
+  schedule_start_ = counters.numel() > 3 ? counters[3].item<int64_t>() : 0;  // older checkpoints: 0
   // Episodes in flight at the interruption are lost; start fresh ones, seeded by position.
   envs_.reset(mix_seed(seed_, 0x10000 + iteration_));
   running_return_.assign(envs_.size(), 0.0);

@@ -96,6 +96,11 @@ class PPO {
   // Sets every action dimension's log std: a run continued from a converged checkpoint
   // has next to no exploration left (PPO here has no entropy bonus).
   void set_log_std(double log_std);
+  // Anneals the learning rate from here to total_steps, rather than over the whole budget
+  // from step 0: a stage continued from another run's checkpoint gets the full rate for
+  // its own steps. Saved with the checkpoint, so a resumed stage keeps its schedule.
+  void restart_lr_schedule() { schedule_start_ = iteration_; }
+  double learning_rate() const;  // the rate the last update used
 
   // Checkpoint: network, optimiser, normalisers, counters and `note` (the resolved
   // recipe), written atomically. `extra` adds an owner's state (a discriminator) to the
@@ -125,6 +130,7 @@ class PPO {
   std::vector<int> noise_age_;     // steps since that draw, reset when an episode ends
   RewardHook reward_hook_;
   int64_t iteration_ = 0, global_step_ = 0;
+  int64_t schedule_start_ = 0;  // the iteration the learning-rate annealing starts from
   double wall_seconds_ = 0.0;
 };
 

@@ -19,6 +19,9 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
     throw root.error("init_policy", "a run starts from init_from or init_policy, not both");
   if (!std::isnan(s.init_log_std) && s.init_from.empty())
     throw root.error("init_log_std", "applies to a run that starts from init_from");
+  s.restart_lr_schedule = root.get("restart_lr_schedule", s.restart_lr_schedule);
+  if (s.restart_lr_schedule && s.init_from.empty())
+    throw root.error("restart_lr_schedule", "applies to a run that starts from init_from");
   try {
     s.make_env = task_factory(s.task, root.sub("env"));
   } catch (const Error& e) {

@@ -8,6 +8,7 @@
 //   checkpoint_every: 5       # iterations
 //   init_from: runs/walker_jump/checkpoint.pt   # optional: continue an earlier run
 //   init_log_std: -1.0        # optional, with init_from: reset the policy's log std
+//   restart_lr_schedule: true # optional, with init_from: anneal ppo.lr over this stage only
 //   init_policy: assets/policies/walker/walker_forward.pt  # optional: start the actor as a skill
 //   env: {...}                # the task's settings (reference defaults)
 //   policy: {pi_hidden: [32, 32], vf_hidden: [32, 32], activation: tanh, init_log_std: -0.5}
@@ -38,6 +39,10 @@ struct SkillRecipe {
   // budget. "" = from scratch.
   std::string init_from;
   double init_log_std = NAN;  // with init_from: the log std to restart exploration at (NaN: keep)
+  // With init_from: anneal the learning rate over this stage's steps. By default the
+  // schedule goes on from the checkpoint's iteration, so a short stage after a long run
+  // trains at a small fraction of ppo.lr (the earlier stages' recipes were measured so).
+  bool restart_lr_schedule = false;
   // A shipped skill (TorchScript) the actor starts as, e.g. walking for the jump: its
   // observation may be a prefix of this task's (the obstacle pair starts at zero weight).
   // The critic, the log std (policy.init_log_std) and the counters start fresh.

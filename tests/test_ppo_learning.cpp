@@ -125,6 +125,40 @@ TEST(PpoLearning, CheckpointResumeRestoresEverythingButInFlightEpisodes) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(PpoLearning, ARestartedScheduleAnnealsOverTheStagesOwnSteps) {
+  // Two iterations of a 4-iteration run, continued by a stage with a 6-iteration budget.
+  // Its first update's rate is lr (1 - 2/6) if the schedule goes on, lr (1 - 0/4) if it
+  // restarts; a resumed restarted stage keeps the restart: lr (1 - 1/4) next.
+  at::set_num_threads(1);
+  ShortWalker s;
+  s.cfg.total_steps = 4 * 2048;
+  auto dir = std::filesystem::temp_directory_path() / ("segue_schedule_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string first = (dir / "first.pt").string(), stage = (dir / "stage.pt").string();
+  VectorEnv e1(s.make, s.cfg.num_envs, 1);
+  PPO a(s.cfg, s.spec, e1, 5);
+  a.iterate();
+  a.iterate();
+  EXPECT_DOUBLE_EQ(a.learning_rate(), s.cfg.lr * (1 - 1.0 / 4));
+  a.save(first);
+  s.cfg.total_steps = 6 * 2048;
+  for (bool restart : {false, true}) {
+    VectorEnv e(s.make, s.cfg.num_envs, 1);
+    PPO b(s.cfg, s.spec, e, 5);
+    b.load(first);
+    if (restart) b.restart_lr_schedule();
+    b.iterate();
+    EXPECT_DOUBLE_EQ(b.learning_rate(), s.cfg.lr * (restart ? 1.0 : 1 - 2.0 / 6));
+    if (restart) b.save(stage);
+  }
+  VectorEnv e3(s.make, s.cfg.num_envs, 1);
+  PPO c(s.cfg, s.spec, e3, 5);
+  c.load(stage);
+  c.iterate();
+  EXPECT_DOUBLE_EQ(c.learning_rate(), s.cfg.lr * (1 - 1.0 / 4));
+  std::filesystem::remove_all(dir);
+}
+
 TEST(PpoLearning, SetLogStdReopensExploration) {
   // A continued run's `init_log_std`: the Gaussian's log density at its own mean is then
   // sum_j (-log_std - log(2 pi) / 2) = 6 (1 - 0.9189385) for log std -1 in all 6 dims.

@@ -107,6 +107,8 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run("train " + zone), "zone.yaml: key 'env.takeoff_zone': must be [low, high] with low < high <= 0");
   auto std_alone = write("std.yaml", "task: walker_forward\ninit_log_std: -1\n");
   expect_one_line_error(run("train " + std_alone), "key 'init_log_std': applies to a run that starts from init_from");
+  auto restart = write("restart.yaml", "task: walker_forward\nrestart_lr_schedule: true\n");
+  expect_one_line_error(run("train " + restart), "key 'restart_lr_schedule': applies to a run that starts from init_from");
   auto both = write("both.yaml", "task: walker_jump\ninit_from: a.pt\ninit_policy: b.pt\n");
   expect_one_line_error(run("train " + both), "key 'init_policy': a run starts from init_from or init_policy, not both");
   const std::string in_tmp = "run_dir: " + (dir_ / "start_run").string() + "\n";

@@ -56,6 +56,7 @@ int train_main(int argc, char** argv) {
       throw Error(recipe_path + ": key 'init_from': no such checkpoint '" + s.init_from + "'");
     ppo.load(from);
     if (!std::isnan(s.init_log_std)) ppo.set_log_std(s.init_log_std);
+    if (s.restart_lr_schedule) ppo.restart_lr_schedule();
     spdlog::info("training {} in {} from {} (iteration {}, {} steps) to {} steps", s.task, dir.path(), s.init_from,
                  ppo.iteration(), ppo.global_step(), s.ppo.total_steps);
   } else if (!s.init_policy.empty()) {
