@@ -2,11 +2,10 @@
 // policy's return; and an interrupted run resumes from its checkpoint.
 #include <gtest/gtest.h>
 
-#include <filesystem>
-
 #include "hrl/evaluation.h"
 #include "algorithms/ppo.h"
 #include "environments/registry.h"
+#include "tests/temp_dir.h"
 
 namespace segue {
 namespace {
@@ -94,13 +93,17 @@ TEST(PpoLearning, RewardHookSeesNextObservationsAndReplacesRewards) {
     if (!bootstrapped[k]) ASSERT_EQ(b.rewards[k], 1.0f) << k;
 }
 
-TEST(PpoLearning, CheckpointResumeRestoresEverythingButInFlightEpisodes) {
+// Tests that write checkpoints, in a scratch folder removed afterwards.
+class PpoCheckpoints : public TempDirTest {
+ protected:
+  PpoCheckpoints() : TempDirTest("ppo") {}
+};
+
+TEST_F(PpoCheckpoints, ResumeRestoresEverythingButInFlightEpisodes) {
   at::set_num_threads(1);
   ShortWalker s;
   s.cfg.total_steps = 4 * 2048;
-  auto dir = std::filesystem::temp_directory_path() / ("segue_resume_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  std::string ckpt = (dir / "checkpoint.pt").string();
+  const std::string ckpt = path("checkpoint.pt");
 
   VectorEnv e1(s.make, s.cfg.num_envs, 1);
   PPO a(s.cfg, s.spec, e1, 5);
@@ -122,19 +125,16 @@ TEST(PpoLearning, CheckpointResumeRestoresEverythingButInFlightEpisodes) {
   // ...and training goes on from there.
   b.iterate();
   EXPECT_EQ(b.global_step(), 3 * 2048);
-  std::filesystem::remove_all(dir);
 }
 
-TEST(PpoLearning, ARestartedScheduleAnnealsOverTheStagesOwnSteps) {
+TEST_F(PpoCheckpoints, ARestartedScheduleAnnealsOverTheStagesOwnSteps) {
   // Two iterations of a 4-iteration run, continued by a stage with a 6-iteration budget.
   // Its first update's rate is lr (1 - 2/6) if the schedule goes on, lr (1 - 0/4) if it
   // restarts; a resumed restarted stage keeps the restart: lr (1 - 1/4) next.
   at::set_num_threads(1);
   ShortWalker s;
   s.cfg.total_steps = 4 * 2048;
-  auto dir = std::filesystem::temp_directory_path() / ("segue_schedule_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  const std::string first = (dir / "first.pt").string(), stage = (dir / "stage.pt").string();
+  const std::string first = path("first.pt"), stage = path("stage.pt");
   VectorEnv e1(s.make, s.cfg.num_envs, 1);
   PPO a(s.cfg, s.spec, e1, 5);
   a.iterate();
@@ -156,7 +156,6 @@ TEST(PpoLearning, ARestartedScheduleAnnealsOverTheStagesOwnSteps) {
   c.load(stage);
   c.iterate();
   EXPECT_DOUBLE_EQ(c.learning_rate(), s.cfg.lr * (1 - 1.0 / 4));
-  std::filesystem::remove_all(dir);
 }
 
 TEST(PpoLearning, SetLogStdReopensExploration) {
