@@ -36,6 +36,7 @@ Factory walker_jump(const std::string& name, const Section& env) {
   j.curb_noise = env.get("curb_noise", j.curb_noise);
   j.cross_bonus = env.get("cross_bonus", j.cross_bonus);
   j.upward_weight = env.get("upward_weight", j.upward_weight);
+  j.height_weight = env.get("height_weight", j.height_weight);
   j.end_x = env.get("end_x", j.end_x);
   j.curb_height = env.get("curb_height", j.curb_height);
   j.curb_height_min = env.get("curb_height_min", j.curb_height);

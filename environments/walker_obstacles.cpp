@@ -199,7 +199,7 @@ double WalkerJump::clearance(int foot, double height) const {
 StepResult WalkerJump::evaluate(const float* action) {
   StepResult r;
   double v = x_velocity();
-  r.reward = walk_reward(v, action, 2.0, 2.0);
+  r.reward = walk_reward(v, action, 2.0, jcfg_.height_weight);
   // Bonuses for the trailing foot crossing each curb's start, centre and end.
   const int marks = 3 * int(obstacles_.size());
   while (crossed_ < marks) {

@@ -88,6 +88,11 @@ class WalkerJump : public WalkerObstacleEnv {
     double curb_x = 7.0, curb_noise = 1.5;
     double cross_bonus = 10.0;  // once each for the trailing foot passing start, centre, end
     double upward_weight = 1.0; // + upward_weight max(vz, 0) while over the curb
+    // The reference's height term, - height_weight |1.1 - delta_h|. delta_h is the torso's
+    // height over the higher foot, so the term charges lifting either foot: it pays a
+    // straight-legged, two-footed hop (the gait every reference-weighted run found) and
+    // charges the alternating, knee-lifting steps a run-up to a jump is made of.
+    double height_weight = 2.0;
     double end_x = 15.0;        // the episode ends past this x
     // Curb height, drawn per episode from [curb_height_min, curb_height]. The task is
     // the 0.4 m curb; a lower minimum is a curriculum that lets training find jumping
