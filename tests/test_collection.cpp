@@ -3,10 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <filesystem>
 
 #include "core/assets.h"
 #include "hrl/collection.h"
+#include "tests/temp_dir.h"
 
 namespace segue {
 namespace {
@@ -48,7 +48,13 @@ TEST(Collection, StartStatesAreAtTheIntervalAndReplayPiA) {
   }
 }
 
-TEST(Collection, DemonstrationsArePiBsOwnStepsInItsWindow) {
+// Collection tests that write their data to files and read it back.
+class CollectionFiles : public TempDirTest {
+ protected:
+  CollectionFiles() : TempDirTest("collect") {}
+};
+
+TEST_F(CollectionFiles, DemonstrationsArePiBsOwnStepsInItsWindow) {
   CompositeRecipe r = patrol();
   // forward -> balance: T_b is balance's first 100 steps from its own start.
   Demonstrations d = collect_demonstrations(r, 0, 250, 3);
@@ -71,20 +77,17 @@ TEST(Collection, DemonstrationsArePiBsOwnStepsInItsWindow) {
   EXPECT_GE(episode_starts, 3);
   EXPECT_LE(episode_starts, 250 / 20);
 
-  auto dir = std::filesystem::temp_directory_path() / ("segue_collect_" + std::to_string(::getpid()));
-  std::filesystem::create_directories(dir);
-  save(d, (dir / "t_b.pt").string());
-  Demonstrations back = load_demonstrations((dir / "t_b.pt").string());
+  save(d, path("t_b.pt"));
+  Demonstrations back = load_demonstrations(path("t_b.pt"));
   EXPECT_EQ(back.obs, d.obs);
   EXPECT_EQ(back.act, d.act);
   EXPECT_EQ(back.next_obs, d.next_obs);
   EXPECT_EQ(back.done, d.done);
   StartStates s = collect_start_states(r, 0, 2, 5);
-  save(s, (dir / "s_a.pt").string());
-  StartStates s2 = load_start_states((dir / "s_a.pt").string());
+  save(s, path("s_a.pt"));
+  StartStates s2 = load_start_states(path("s_a.pt"));
   EXPECT_EQ(s2.states, s.states);
   EXPECT_EQ(s2.obs, s.obs);
-  std::filesystem::remove_all(dir);
 }
 
 TEST(Collection, StartStatesWhereATransitionPolicyIntoAHandsOver) {
