@@ -54,6 +54,10 @@ Factory walker_jump(const std::string& name, const Section& env) {
   j.takeoff_bonus = env.get("takeoff_bonus", j.takeoff_bonus);
   j.close_stance_cost = env.get("close_stance_cost", j.close_stance_cost);
   j.stance_height = env.get("stance_height", j.stance_height);
+  j.placement_bonus = env.get("placement_bonus", j.placement_bonus);
+  j.placement_target = env.get("placement_target", j.placement_target);
+  j.placement_width = env.get("placement_width", j.placement_width);
+  if (j.placement_width <= 0) throw env.error("placement_width", "must be positive");
   if (env.has("takeoff_zone")) {
     const auto zone = env.get("takeoff_zone", std::vector<double>());
     if (zone.size() != 2 || !(zone[0] < zone[1]) || zone[1] > 0)

@@ -187,13 +187,22 @@ void WalkerJump::reset_task() {
   }
   set_obstacles(layout);
   for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
-  crossed_ = 0, touched_ = 0, took_off_ = 0;
+  crossed_ = 0, touched_ = 0, took_off_ = 0, placed_ = 0;
+  footfall_curb_ = -1, footfall_ = 0.0;
   peak_curb_ = -1, peak_ = 0.0;
   WalkerEnv::reset_task();
 }
 
 double WalkerJump::clearance(int foot, double height) const {
   return std::clamp((data_->xpos[3 * foot + 2] - kFootRadius) / height, 0.0, 1.0);
+}
+
+double WalkerJump::placement_reward(int k) {
+  if (k < 0 || k >= 32 || (placed_ >> k & 1u)) return 0.0;
+  placed_ |= 1u << k;
+  if (footfall_curb_ != k) return 0.0;
+  const double z = (footfall_ - jcfg_.placement_target) / jcfg_.placement_width;
+  return jcfg_.placement_bonus * std::exp(-0.5 * z * z);
 }
 
 StepResult WalkerJump::evaluate(const float* action) {
@@ -205,6 +214,7 @@ StepResult WalkerJump::evaluate(const float* action) {
   while (crossed_ < marks) {
     if (trailing_foot_x() <= bonus_points(obstacles_[crossed_ / 3])[crossed_ % 3]) break;
     if (!(touched_ >> (crossed_ / 3) & 1u)) r.reward += jcfg_.cross_bonus;
+    if (crossed_ % 3 == 0) r.reward += placement_reward(crossed_ / 3);
     ++crossed_;
   }
   if (jcfg_.mark_upward_weight != 0.0)
@@ -232,6 +242,11 @@ StepResult WalkerJump::evaluate(const float* action) {
       else if (at > jcfg_.takeoff_zone[1] && at < 0.0)
         r.reward -= jcfg_.close_stance_cost;
     }
+    const double a1 = data_->xpos[3 * foot_] - curb.start, a2 = data_->xpos[3 * foot_left_] - curb.start;
+    if (std::max(a1, a2) < 0.0)
+      for (auto [f, at] : {std::pair{foot_, a1}, std::pair{foot_left_, a2}})
+        if (data_->xpos[3 * f + 2] <= jcfg_.stance_height && (footfall_curb_ != next || at > footfall_))
+          footfall_curb_ = next, footfall_ = at;
   }
   bool contact = false;
   if (jcfg_.ghost_curbs) {
@@ -246,6 +261,7 @@ StepResult WalkerJump::evaluate(const float* action) {
   } else if ((contact = touching())) {
     r.reward -= ocfg_.contact_penalty;
     if (next >= 0 && next < 32) touched_ |= 1u << next;
+    r.reward += placement_reward(next);
   }
   update_passed();
   r.info.success = passed_ == int(obstacles_.size()) && touched_ == 0;
@@ -263,6 +279,9 @@ void WalkerJump::save_extra(std::vector<double>& out) const {
   out.push_back(touched_);
   out.push_back(took_off_);
   out.insert(out.end(), heights_.begin(), heights_.end());
+  out.push_back(placed_);
+  out.push_back(footfall_curb_);
+  out.push_back(footfall_);
 }
 void WalkerJump::restore_extra(const double* in, size_t n) {
   crossed_ = n > 0 ? int(in[0]) : 0;
@@ -273,6 +292,10 @@ void WalkerJump::restore_extra(const double* in, size_t n) {
   heights_.assign(obstacles_.size(), jcfg_.curb_height);
   for (size_t k = 0; k + 5 < n && k < heights_.size(); ++k) heights_[k] = in[5 + k];
   for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
+  const size_t p = 5 + heights_.size();  // placement state follows the heights
+  placed_ = n > p ? uint32_t(in[p]) : 0u;
+  footfall_curb_ = n > p + 1 ? int(in[p + 1]) : -1;
+  footfall_ = n > p + 2 ? in[p + 2] : 0.0;
 }
 
 // ---- crawl -----------------------------------------------------------------------------

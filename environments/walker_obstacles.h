@@ -136,6 +136,14 @@ class WalkerJump : public WalkerObstacleEnv {
     double takeoff_bonus = 0.0, close_stance_cost = 0.0;
     std::array<double, 2> takeoff_zone = {-1.2, -0.6};
     double stance_height = 0.08;
+    // Graded take-off shaping (training only): once per curb, when its outcome is decided
+    // (the trailing foot passes its start, or the walker first touches it), + placement_bonus
+    // exp(-((x - placement_target) / placement_width)^2 / 2), x the last footfall before the
+    // curb (the last foot in stance while both were before it). Success is a window of
+    // take-off points (stage 3: [-1.23, -0.59] m) and is flat outside it, so a take-off
+    // 0.5 m off gains nothing from a slightly longer or shorter step; the takeoff_zone bonus
+    // is flat in the same way. This term rewards every step of the way towards the window.
+    double placement_bonus = 0.0, placement_target = -0.8, placement_width = 0.3;
   };
   WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
   // Summed depth of the walker's capsules in curb k's box (capsule_depth_in_box): what
@@ -155,12 +163,17 @@ class WalkerJump : public WalkerObstacleEnv {
   // How far the bottom of `foot` (a body id) is above the ground, as a fraction of the
   // curb's height, in [0, 1].
   double clearance(int foot, double height) const;
+  // placement_bonus for curb k's last footfall (0 without one), paid once.
+  double placement_reward(int k);
   std::vector<int> walker_capsules_;  // the walker's geoms (all capsules), for depth_in_curb
 
   Config jcfg_;
   int crossed_ = 0;              // marks (start, centre, end of each curb) the trailing foot has crossed
   uint32_t touched_ = 0;         // bit k: curb k was touched (only with contact_ends false)
   uint32_t took_off_ = 0;        // bit k: curb k's takeoff_bonus was paid
+  uint32_t placed_ = 0;          // bit k: curb k's placement_bonus was paid
+  int footfall_curb_ = -1;       // the curb footfall_ belongs to
+  double footfall_ = 0.0;        // last footfall before that curb, relative to its start
   int peak_curb_ = -1;           // the curb peak_ belongs to
   double peak_ = 0.0;            // highest lower-foot clearance (m) in that curb's window so far
   std::vector<double> heights_;  // per curb

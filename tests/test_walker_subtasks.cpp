@@ -224,6 +224,61 @@ TEST(WalkerJump, TakeoffShapingPaysAStanceInTheZoneOnceAndChargesOneTooClose) {
   EXPECT_NEAR(shaped[0] - plain[0], 0.0, 1e-6);
 }
 
+TEST(WalkerJump, PlacementBonusPaysTheLastFootfallOnceWhenTheCurbIsDecided) {
+  // Curb at 7.0. The walker stands with both ankles at x - 7.0 = `at` for two steps, then
+  // is lifted 1 m and moved past the curb (`over`) or into it: the trailing foot passing
+  // the curb's start, or the touch, pays B exp(-((at - target) / width)^2 / 2) once.
+  // contact_ends false keeps the touching twin going for the "once" check.
+  // Twin envs differ only in placement_bonus.
+  auto rewards = [](double at, bool over, const std::string& shaping) {
+    auto env = make_task("walker_jump", "{curb_noise: 0, push_prob: 0, init_random_steps: 0, init_noise: 0, "
+                                        "contact_ends: false" + shaping + "}");
+    std::vector<float> obs(28);
+    env->reset(0, obs.data());
+    auto& m = dynamic_cast<MujocoEnv&>(*env);
+    const int f1 = mj_name2id(m.model(), mjOBJ_BODY, "foot");
+    shift_x(*env, 0.0, obs);
+    const double ankle_offset = m.data()->xpos[3 * f1];
+    m.mutable_data()->qpos[1] -= m.data()->xpos[3 * f1 + 2] - 0.06;  // onto its feet
+    shift_x(*env, 7.0 + at - ankle_offset, obs);
+    std::vector<double> r;
+    for (int t = 0; t < 2; ++t) r.push_back(env->step(kZero, obs.data()).reward);
+    if (over) {
+      m.mutable_data()->qpos[1] += 1.0;  // feet 1 m up, trailing foot past the curb's end
+      shift_x(*env, 7.5 - ankle_offset, obs);
+    } else {
+      m.mutable_data()->qpos[1] += 0.15;  // feet off the floor (no new footfall) ...
+      shift_x(*env, 7.0 - 0.05 - ankle_offset, obs);  // ... and reaching into the curb
+    }
+    for (int t = 0; t < 2; ++t) r.push_back(env->step(kZero, obs.data()).reward);
+    return r;
+  };
+  const std::string shaping = ", placement_bonus: 100, placement_target: -0.8, placement_width: 0.3";
+  for (bool over : {true, false})
+    for (double at : {-0.8, -1.1, -2.0}) {
+      auto plain = rewards(at, over, ""), shaped = rewards(at, over, shaping);
+      const double z = (at + 0.8) / 0.3, want = 100.0 * std::exp(-0.5 * z * z);
+      EXPECT_NEAR(shaped[0] - plain[0], 0.0, 1e-6) << at;  // nothing while standing
+      EXPECT_NEAR(shaped[1] - plain[1], 0.0, 1e-6) << at;
+      // The standing feet settle by < 1 mm: 0.2 covers that (the slope is <= 202 a metre).
+      EXPECT_NEAR(shaped[2] - plain[2], want, 0.2) << at << (over ? " over" : " touching");
+      EXPECT_NEAR(shaped[3] - plain[3], 0.0, 1e-6) << at;  // once
+    }
+  // No footfall before the curb (the walker starts in the air past it): nothing.
+  auto env = make_task("walker_jump", "{curb_noise: 0, push_prob: 0, init_random_steps: 0, placement_bonus: 100}");
+  auto plain = make_task("walker_jump", "{curb_noise: 0, push_prob: 0, init_random_steps: 0}");
+  std::vector<float> obs(28);
+  double r[2];
+  int i = 0;
+  for (Env* e : {env.get(), plain.get()}) {
+    e->reset(0, obs.data());
+    dynamic_cast<MujocoEnv&>(*e).mutable_data()->qpos[1] += 1.0;
+    shift_x(*e, 7.5, obs);
+    r[i++] = e->step(kZero, obs.data()).reward;
+  }
+  EXPECT_NEAR(r[0] - r[1], 0.0, 1e-6);
+}
+
 TEST(WalkerJump, EpisodeEndsPastX15) {
   auto env = make_task("walker_jump", "{curb_noise: 0, push_prob: 0}");
   std::vector<float> obs(28);

@@ -2,8 +2,9 @@
 // reference jump task. For each episode: success, fall or curb contact; for a contact,
 // which geom touched and where the walker was; how deep it reached into the curb (with
 // ghost_curbs=true); and where its last two-footed stance before the curb was (mean ankle
-// x minus the curb's start): the take-off point of a hop. TRACE=1 prints every step near
-// the curb.
+// x minus the curb's start): the take-off point of a hop; and the last footfall before the
+// curb (either foot, ankle x minus the curb's start): the take-off of an alternating run.
+// TRACE=1 prints every step near the curb.
 // Build: cmake --build build --target probe_jump_failures
 // usage: build/probe_jump_failures POLICY N SEED [key=value ...]  (env keys, e.g. curb_height=0.2)
 #include <mujoco/mujoco.h>
@@ -49,6 +50,7 @@ int main(int argc, char** argv) {
   const int floor = mj_name2id(m, mjOBJ_GEOM, "floor");
   const int f1 = mj_name2id(m, mjOBJ_BODY, "foot"), f2 = mj_name2id(m, mjOBJ_BODY, "foot_left");
   std::map<std::string, std::vector<double>> stances;  // outcome -> last stances
+  std::map<std::string, std::vector<double>> takeoffs;  // outcome -> last footfalls
   std::map<std::string, int> ends;
   std::vector<float> obs(env->spec().obs_dim), act(env->spec().act_dim);
   for (int e = 0; e < n; ++e) {
@@ -56,6 +58,7 @@ int main(int argc, char** argv) {
     int steps = 0;
     double deepest = 0.0;  // the walker's summed depth in the curb (nonzero only with ghost curbs)
     double last_stance = NAN;
+    double takeoff = NAN;  // the last foot on the ground before the curb (an alternating gait's take-off)
     for (;;) {
       pi.act(obs.data(), 1, act.data());
       StepResult r = env->step(act.data(), obs.data());
@@ -66,6 +69,8 @@ int main(int argc, char** argv) {
       deepest = std::max(deepest, depth);
       const double a1 = d->xpos[3 * f1] - curb.start, a2 = d->xpos[3 * f2] - curb.start;
       if (d->xpos[3 * f1 + 2] < 0.07 && d->xpos[3 * f2 + 2] < 0.07 && std::max(a1, a2) < 0) last_stance = 0.5 * (a1 + a2);
+      for (auto [z, a] : {std::pair{d->xpos[3 * f1 + 2], a1}, std::pair{d->xpos[3 * f2 + 2], a2}})
+        if (z < 0.07 && a < 0 && std::max(a1, a2) < 0) takeoff = a;
       if (std::getenv("TRACE") && d->qpos[0] > curb.start - 2.0) {
         std::printf("  x-start %+.2f torso z %.2f  foot (%+.2f, %.2f)  foot_left (%+.2f, %.2f)\n", d->qpos[0] - curb.start,
                     d->qpos[1], d->xpos[3 * f1] - curb.start, d->xpos[3 * f1 + 2], d->xpos[3 * f2] - curb.start,
@@ -91,16 +96,18 @@ int main(int argc, char** argv) {
       ++ends[why];
       const std::string outcome = why.substr(0, why.find_first_of(" ,"));
       if (!std::isnan(last_stance)) stances[outcome].push_back(last_stance);
-      std::printf("episode %d: %s after %d steps, torso x %.2f, obs start-x %.2f, deepest %.3f, last stance %.2f\n",
-                  e, why.c_str(), steps, d->qpos[0], obs[26], deepest, last_stance);
+      if (!std::isnan(takeoff)) takeoffs[outcome].push_back(takeoff);
+      std::printf("episode %d: %s after %d steps, torso x %.2f, obs start-x %.2f, deepest %.3f, last stance %.2f, "
+                  "take-off %.2f\n", e, why.c_str(), steps, d->qpos[0], obs[26], deepest, last_stance, takeoff);
       break;
     }
   }
-  for (auto& kv : stances) {
-    std::sort(kv.second.begin(), kv.second.end());
-    std::printf("last stance before the curb, %s:", kv.first.c_str());
-    for (double x : kv.second) std::printf(" %.2f", x);
-    std::printf("\n");
-  }
+  for (auto [what, by_outcome] : {std::pair{"last stance", &stances}, std::pair{"take-off", &takeoffs}})
+    for (auto& kv : *by_outcome) {
+      std::sort(kv.second.begin(), kv.second.end());
+      std::printf("%s before the curb, %s:", what, kv.first.c_str());
+      for (double x : kv.second) std::printf(" %.2f", x);
+      std::printf("\n");
+    }
   for (auto& kv : ends) std::printf("%-32s %d\n", kv.first.c_str(), kv.second);
 }
