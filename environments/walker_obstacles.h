@@ -138,8 +138,8 @@ class WalkerJump : public WalkerObstacleEnv {
     double stance_height = 0.08;
     // Graded take-off shaping (training only): once per curb, when its outcome is decided
     // (the trailing foot passes its start, or the walker first touches it), + placement_bonus
-    // exp(-((x - placement_target) / placement_width)^2 / 2), x the last footfall before the
-    // curb (the last foot in stance while both were before it). Success is a window of
+    // exp(-((x - placement_target) / placement_width)^2 / 2), x the frontmost footfall before
+    // the curb (while both feet were before it; in a forward run, the take-off). Success is a window of
     // take-off points (stage 3: [-1.23, -0.59] m) and is flat outside it, so a take-off
     // 0.5 m off gains nothing from a slightly longer or shorter step; the takeoff_zone bonus
     // is flat in the same way. This term rewards every step of the way towards the window.
@@ -163,7 +163,7 @@ class WalkerJump : public WalkerObstacleEnv {
   // How far the bottom of `foot` (a body id) is above the ground, as a fraction of the
   // curb's height, in [0, 1].
   double clearance(int foot, double height) const;
-  // placement_bonus for curb k's last footfall (0 without one), paid once.
+  // placement_bonus for curb k's frontmost footfall (0 without one), paid once.
   double placement_reward(int k);
   std::vector<int> walker_capsules_;  // the walker's geoms (all capsules), for depth_in_curb
 
@@ -173,7 +173,7 @@ class WalkerJump : public WalkerObstacleEnv {
   uint32_t took_off_ = 0;        // bit k: curb k's takeoff_bonus was paid
   uint32_t placed_ = 0;          // bit k: curb k's placement_bonus was paid
   int footfall_curb_ = -1;       // the curb footfall_ belongs to
-  double footfall_ = 0.0;        // last footfall before that curb, relative to its start
+  double footfall_ = 0.0;        // frontmost footfall before that curb, relative to its start
   int peak_curb_ = -1;           // the curb peak_ belongs to
   double peak_ = 0.0;            // highest lower-foot clearance (m) in that curb's window so far
   std::vector<double> heights_;  // per curb

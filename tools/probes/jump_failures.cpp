@@ -2,8 +2,8 @@
 // reference jump task. For each episode: success, fall or curb contact; for a contact,
 // which geom touched and where the walker was; how deep it reached into the curb (with
 // ghost_curbs=true); and where its last two-footed stance before the curb was (mean ankle
-// x minus the curb's start): the take-off point of a hop; and the last footfall before the
-// curb (either foot, ankle x minus the curb's start): the take-off of an alternating run.
+// x minus the curb's start): the take-off point of a hop; and the frontmost footfall before
+// the curb (either foot's ankle x minus the curb's start): the take-off of an alternating run.
 // TRACE=1 prints every step near the curb.
 // Build: cmake --build build --target probe_jump_failures
 // usage: build/probe_jump_failures POLICY N SEED [key=value ...]  (env keys, e.g. curb_height=0.2)
@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   const int floor = mj_name2id(m, mjOBJ_GEOM, "floor");
   const int f1 = mj_name2id(m, mjOBJ_BODY, "foot"), f2 = mj_name2id(m, mjOBJ_BODY, "foot_left");
   std::map<std::string, std::vector<double>> stances;  // outcome -> last stances
-  std::map<std::string, std::vector<double>> takeoffs;  // outcome -> last footfalls
+  std::map<std::string, std::vector<double>> takeoffs;  // outcome -> frontmost footfalls
   std::map<std::string, int> ends;
   std::vector<float> obs(env->spec().obs_dim), act(env->spec().act_dim);
   for (int e = 0; e < n; ++e) {
@@ -69,8 +69,10 @@ int main(int argc, char** argv) {
       deepest = std::max(deepest, depth);
       const double a1 = d->xpos[3 * f1] - curb.start, a2 = d->xpos[3 * f2] - curb.start;
       if (d->xpos[3 * f1 + 2] < 0.07 && d->xpos[3 * f2 + 2] < 0.07 && std::max(a1, a2) < 0) last_stance = 0.5 * (a1 + a2);
+      double front = -INFINITY;  // the frontmost foot standing this step, as the env's placement_bonus counts it
       for (auto [z, a] : {std::pair{d->xpos[3 * f1 + 2], a1}, std::pair{d->xpos[3 * f2 + 2], a2}})
-        if (z < 0.07 && a < 0 && std::max(a1, a2) < 0) takeoff = a;
+        if (z < 0.07 && a < 0 && std::max(a1, a2) < 0) front = std::max(front, a);
+      if (front > -INFINITY) takeoff = front;
       if (std::getenv("TRACE") && d->qpos[0] > curb.start - 2.0) {
         std::printf("  x-start %+.2f torso z %.2f  foot (%+.2f, %.2f)  foot_left (%+.2f, %.2f)\n", d->qpos[0] - curb.start,
                     d->qpos[1], d->xpos[3 * f1] - curb.start, d->xpos[3 * f1 + 2], d->xpos[3 * f2] - curb.start,
