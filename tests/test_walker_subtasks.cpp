@@ -224,7 +224,7 @@ TEST(WalkerJump, TakeoffShapingPaysAStanceInTheZoneOnceAndChargesOneTooClose) {
   EXPECT_NEAR(shaped[0] - plain[0], 0.0, 1e-6);
 }
 
-TEST(WalkerJump, PlacementBonusPaysTheLastFootfallOnceWhenTheCurbIsDecided) {
+TEST(WalkerJump, PlacementBonusPaysTheFrontmostFootfallOnceWhenTheCurbIsDecided) {
   // Curb at 7.0. The walker stands with both ankles at x - 7.0 = `at` for two steps, then
   // is lifted 1 m and moved past the curb (`over`) or into it: the trailing foot passing
   // the curb's start, or the touch, pays B exp(-((at - target) / width)^2 / 2) once.
@@ -354,25 +354,17 @@ TEST(WalkerJump, ClearanceTermByHand) {
 }
 
 TEST(WalkerJump, HeightWeightScalesTheHeightTermByHand) {
-  // Left thigh swung back 0.6 rad, its foot lifted: the higher foot sets delta_h. Lifted
-  // 0.2 m as well so no foot touches the floor. The two rewards differ by
-  // (2 - 0.5) |1.1 - delta_h|, delta_h after the step (one control step of free fall
-  // barely moves it: 1e-3 tolerance).
+  // Left thigh swung back 0.6 rad, the walker lifted 0.2 m so no foot touches the floor.
+  // The thigh (0.45) and shin (0.5) swung: the left ankle, now the higher foot, rises
+  // 0.95 (1 - cos 0.6), and the torso's origin sits 0.2 above the hip, so
+  // delta_h = 0.2 + 0.95 cos 0.6. Rewards at weights 2 and 0.5 differ by
+  // -1.5 |1.1 - delta_h| (one control step of free fall barely moves it: 3e-3).
   const std::string base = "{curb_noise: 0, init_noise: 0, init_random_steps: 0, push_prob: 0, height_weight: ";
   auto place = [](double* qpos) { qpos[0] = 2.0, qpos[1] = 1.45, qpos[6] = -0.6; };
-  auto env = make_task("walker_jump", base + "2}");
-  std::vector<float> obs(28);
-  env->reset(0, obs.data());
-  auto& m = dynamic_cast<MujocoEnv&>(*env);
-  place(m.mutable_data()->qpos);
-  m.forward(obs.data());
-  const double reference = env->step(kZero, obs.data()).reward;
-  // The thigh (0.45) and shin (0.5) swung 0.6 rad: the left ankle rises 0.95 (1 - cos 0.6),
-  // and the torso's origin sits 0.2 above the hip: delta_h = 0.2 + 0.95 cos 0.6.
-  const double delta_h = dynamic_cast<WalkerEnv&>(*env).delta_h();
-  EXPECT_NEAR(delta_h, 0.2 + 0.95 * std::cos(0.6), 2e-3);
-  const double lighter = reward_after_placing("walker_jump", base + "0.5}", place);
-  EXPECT_NEAR(reference - lighter, -1.5 * std::abs(1.1 - delta_h), 1e-3);
+  const double delta_h = 0.2 + 0.95 * std::cos(0.6);
+  EXPECT_NEAR(reward_after_placing("walker_jump", base + "2}", place) -
+                  reward_after_placing("walker_jump", base + "0.5}", place),
+              -1.5 * std::abs(1.1 - delta_h), 3e-3);
 }
 
 TEST(WalkerJump, PeakTermPaysOnlyNewHeights) {
