@@ -234,19 +234,17 @@ StepResult WalkerJump::evaluate(const float* action) {
       const double rise = lower * heights_[next] - peak_;
       if (rise > 0) r.reward += jcfg_.peak_weight * rise, peak_ += rise;
     }
-    for (int f : {foot_, foot_left_}) {
+    // Each foot in stance, at its ankle's x relative to the curb's start.
+    const double a1 = data_->xpos[3 * foot_] - curb.start, a2 = data_->xpos[3 * foot_left_] - curb.start;
+    const bool both_before = std::max(a1, a2) < 0.0;
+    for (auto [f, at] : {std::pair{foot_, a1}, std::pair{foot_left_, a2}}) {
       if (data_->xpos[3 * f + 2] > jcfg_.stance_height) continue;
-      const double at = data_->xpos[3 * f] - curb.start;
       if (at >= jcfg_.takeoff_zone[0] && at <= jcfg_.takeoff_zone[1] && !(took_off_ >> next & 1u))
         r.reward += jcfg_.takeoff_bonus, took_off_ |= 1u << next;
       else if (at > jcfg_.takeoff_zone[1] && at < 0.0)
         r.reward -= jcfg_.close_stance_cost;
+      if (both_before && (footfall_curb_ != next || at > footfall_)) footfall_curb_ = next, footfall_ = at;
     }
-    const double a1 = data_->xpos[3 * foot_] - curb.start, a2 = data_->xpos[3 * foot_left_] - curb.start;
-    if (std::max(a1, a2) < 0.0)
-      for (auto [f, at] : {std::pair{foot_, a1}, std::pair{foot_left_, a2}})
-        if (data_->xpos[3 * f + 2] <= jcfg_.stance_height && (footfall_curb_ != next || at > footfall_))
-          footfall_curb_ = next, footfall_ = at;
   }
   bool contact = false;
   if (jcfg_.ghost_curbs) {

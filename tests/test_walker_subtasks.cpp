@@ -23,6 +23,18 @@ void shift_x(Env& env, double x, std::vector<float>& obs) {
 
 const float kZero[6] = {0, 0, 0, 0, 0, 0};
 
+// Stands the walker on its feet (foot radius 0.06) with both ankles at x = 7.0 + at, the
+// jump's curb starting at 7.0 without noise; returns the ankles' x offset from rootx.
+double stand_before_curb(Env& env, double at, std::vector<float>& obs) {
+  auto& m = dynamic_cast<MujocoEnv&>(env);
+  const int foot = mj_name2id(m.model(), mjOBJ_BODY, "foot");
+  shift_x(env, 0.0, obs);
+  const double ankle_offset = m.data()->xpos[3 * foot];  // the ankles' x in the standing pose
+  m.mutable_data()->qpos[1] -= m.data()->xpos[3 * foot + 2] - 0.06;  // lowered onto its feet
+  shift_x(env, 7.0 + at - ankle_offset, obs);
+  return ankle_offset;
+}
+
 // The reward of one zero-action step of `task` (with `settings`) from its seed-0 start
 // after `place` has edited qpos: two calls that differ in one reward term's weight differ
 // by exactly that term.
@@ -196,10 +208,7 @@ TEST(WalkerJump, TakeoffShapingPaysAStanceInTheZoneOnceAndChargesOneTooClose) {
     env->reset(0, obs.data());
     auto& m = dynamic_cast<MujocoEnv&>(*env);
     const int f1 = mj_name2id(m.model(), mjOBJ_BODY, "foot"), f2 = mj_name2id(m.model(), mjOBJ_BODY, "foot_left");
-    shift_x(*env, 0.0, obs);
-    const double ankle_offset = m.data()->xpos[3 * f1];  // the ankles' x in the standing pose
-    m.mutable_data()->qpos[1] -= m.data()->xpos[3 * f1 + 2] - 0.06;  // lowered onto its feet (radius 0.06)
-    shift_x(*env, 7.0 + at - ankle_offset, obs);
+    stand_before_curb(*env, at, obs);
     std::vector<double> rewards;
     for (int t = 0; t < 2; ++t) {
       rewards.push_back(env->step(kZero, obs.data()).reward);
@@ -236,11 +245,7 @@ TEST(WalkerJump, PlacementBonusPaysTheFrontmostFootfallOnceWhenTheCurbIsDecided)
     std::vector<float> obs(28);
     env->reset(0, obs.data());
     auto& m = dynamic_cast<MujocoEnv&>(*env);
-    const int f1 = mj_name2id(m.model(), mjOBJ_BODY, "foot");
-    shift_x(*env, 0.0, obs);
-    const double ankle_offset = m.data()->xpos[3 * f1];
-    m.mutable_data()->qpos[1] -= m.data()->xpos[3 * f1 + 2] - 0.06;  // onto its feet
-    shift_x(*env, 7.0 + at - ankle_offset, obs);
+    const double ankle_offset = stand_before_curb(*env, at, obs);
     std::vector<double> r;
     for (int t = 0; t < 2; ++t) r.push_back(env->step(kZero, obs.data()).reward);
     if (over) {

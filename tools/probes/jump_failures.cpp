@@ -70,8 +70,9 @@ int main(int argc, char** argv) {
       const double a1 = d->xpos[3 * f1] - curb.start, a2 = d->xpos[3 * f2] - curb.start;
       if (d->xpos[3 * f1 + 2] < 0.07 && d->xpos[3 * f2 + 2] < 0.07 && std::max(a1, a2) < 0) last_stance = 0.5 * (a1 + a2);
       double front = -INFINITY;  // the frontmost foot standing this step, as the env's placement_bonus counts it
-      for (auto [z, a] : {std::pair{d->xpos[3 * f1 + 2], a1}, std::pair{d->xpos[3 * f2 + 2], a2}})
-        if (z < 0.07 && a < 0 && std::max(a1, a2) < 0) front = std::max(front, a);
+      if (std::max(a1, a2) < 0)
+        for (auto [z, a] : {std::pair{d->xpos[3 * f1 + 2], a1}, std::pair{d->xpos[3 * f2 + 2], a2}})
+          if (z < 0.07) front = std::max(front, a);
       if (front > -INFINITY) takeoff = front;
       if (std::getenv("TRACE") && d->qpos[0] > curb.start - 2.0) {
         std::printf("  x-start %+.2f torso z %.2f  foot (%+.2f, %.2f)  foot_left (%+.2f, %.2f)\n", d->qpos[0] - curb.start,
