@@ -14,6 +14,9 @@ struct ActorCriticSpec {
   std::vector<int> vf_hidden{32, 32};
   Activation activation = Activation::Tanh;
   double init_log_std = -0.5;
+  // [begin, end) of the observation that neither network sees (the normaliser maps it to
+  // 0); empty = none. The reference's walker primitives saw no qacc: [17, 26].
+  std::vector<int> ignore_obs;
 };
 
 class ActorCriticImpl : public torch::nn::Module {

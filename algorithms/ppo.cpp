@@ -45,6 +45,7 @@ PPO::PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, u
       seed_(seed) {
   torch::manual_seed(mix_seed(seed, 0x5e9e));
   net_ = ActorCritic(net);
+  if (!net.ignore_obs.empty()) obs_rms_.ignore(net.ignore_obs.at(0), net.ignore_obs.at(1));
   optimizer_ = std::make_unique<torch::optim::Adam>(net_->parameters(),
                                                      torch::optim::AdamOptions(cfg_.lr).eps(1e-5));
   buf_.resize(cfg_.steps_per_env, envs.size(), net.obs_dim, net.act_dim);
@@ -285,6 +286,7 @@ void PPO::init_actor(const Policy& p, float extra_bias) {
   // Inputs the policy does not see (beyond its obs_dim) start unscaled: mean 0, var 1.
   std::vector<double> mean(buf_.obs_dim, 0.0), var(buf_.obs_dim, 1.0);
   for (int j = 0; j < p.obs_dim(); ++j) {
+    if (p.obs_inv_std()[j] == 0.0f) obs_rms_.ignore(j, j + 1);  // inputs the policy ignores stay ignored
     mean[j] = p.obs_mean()[j];
     var[j] = std::max(1.0 / (double(p.obs_inv_std()[j]) * p.obs_inv_std()[j]) - obs_rms_.eps(), 0.0);
   }

@@ -38,6 +38,7 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
     throw pol.error("activation", e.what());
   }
   s.net.init_log_std = pol.get("init_log_std", s.net.init_log_std);
+  s.net.ignore_obs = pol.get("ignore_obs", s.net.ignore_obs);
   s.ppo = PpoConfig::read(root.sub("ppo"));
   Section ev = root.sub("eval");
   s.eval_episodes = ev.get("episodes", s.eval_episodes);
@@ -48,6 +49,9 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   if (s.checkpoint_every <= 0) throw root.error("checkpoint_every", "must be positive");
   auto probe = s.make_env();
   s.net.obs_dim = probe->spec().obs_dim;
+  const auto& ig = s.net.ignore_obs;
+  if (!ig.empty() && (ig.size() != 2 || ig[0] < 0 || ig[0] >= ig[1] || ig[1] > s.net.obs_dim))
+    throw pol.error("ignore_obs", "must be [begin, end) with 0 <= begin < end <= " + std::to_string(s.net.obs_dim));
   s.net.act_dim = probe->spec().act_dim;
   return s;
 }

@@ -11,7 +11,8 @@
 //   restart_lr_schedule: true # optional, with init_from: anneal ppo.lr over this stage only
 //   init_policy: assets/policies/walker/walker_forward.pt  # optional: start the actor as a skill
 //   env: {...}                # the task's settings (reference defaults)
-//   policy: {pi_hidden: [32, 32], vf_hidden: [32, 32], activation: tanh, init_log_std: -0.5}
+//   policy: {pi_hidden: [32, 32], vf_hidden: [32, 32], activation: tanh, init_log_std: -0.5,
+//            ignore_obs: [17, 26]}   # optional: inputs neither net sees (here the qacc)
 //   ppo: {...}                # see PpoConfig
 //   eval: {episodes: 50, seed: 1000, reference_task: false}
 //

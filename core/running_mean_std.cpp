@@ -8,7 +8,7 @@
 namespace segue {
 
 RunningMeanStd::RunningMeanStd(int dim, double clip, double eps)
-    : mean_(dim, 0.0), var_(dim, 1.0), clip_(clip), eps_(eps) {
+    : mean_(dim, 0.0), var_(dim, 1.0), ignored_(dim, 0), clip_(clip), eps_(eps) {
   refresh();
 }
 
@@ -48,11 +48,19 @@ void RunningMeanStd::set(const std::vector<double>& mean, const std::vector<doub
   refresh();
 }
 
+void RunningMeanStd::ignore(int begin, int end) {
+  if (begin < 0 || end > dim() || begin > end) throw Error("RunningMeanStd::ignore: range outside the input");
+  std::fill(ignored_.begin() + begin, ignored_.begin() + end, 1);
+  refresh();
+}
+
 void RunningMeanStd::refresh() {
   mean_f_.assign(mean_.begin(), mean_.end());
   inv_std_.resize(mean_.size());
-  for (size_t j = 0; j < mean_.size(); ++j)
-    inv_std_[j] = static_cast<float>(1.0 / std::sqrt(var_[j] + eps_));
+  for (size_t j = 0; j < mean_.size(); ++j) {
+    inv_std_[j] = ignored_[j] ? 0.0f : static_cast<float>(1.0 / std::sqrt(var_[j] + eps_));
+    if (ignored_[j]) mean_f_[j] = 0.0f;
+  }
 }
 
 void RunningMeanStd::normalize(const float* in, float* out) const {
@@ -66,6 +74,7 @@ void RunningMeanStd::save(torch::serialize::OutputArchive& ar, const std::string
   ar.write(p + "mean", torch::tensor(mean_, opts));
   ar.write(p + "var", torch::tensor(var_, opts));
   ar.write(p + "count", torch::tensor({count_, clip_, eps_}, opts));
+  ar.write(p + "ignored", torch::tensor(std::vector<int64_t>(ignored_.begin(), ignored_.end())));
 }
 
 void RunningMeanStd::load(torch::serialize::InputArchive& ar, const std::string& p) {
@@ -78,6 +87,14 @@ void RunningMeanStd::load(torch::serialize::InputArchive& ar, const std::string&
   count_ = c[0].item<double>();
   clip_ = c[1].item<double>();
   eps_ = c[2].item<double>();
+  // The saved mask joins the one this normaliser was built with (older archives have none).
+  torch::Tensor ig;
+  ignored_.resize(mean_.size(), 0);
+  if (ar.try_read(p + "ignored", ig)) {
+    if (ig.numel() != static_cast<int64_t>(mean_.size())) throw Error("RunningMeanStd::load: mask of the wrong size");
+    auto v = ig.to(torch::kInt64).contiguous();
+    for (int64_t j = 0; j < v.numel(); ++j) ignored_[j] |= v.data_ptr<int64_t>()[j] != 0;
+  }
   refresh();
 }
 

@@ -16,6 +16,11 @@ class RunningMeanStd {
   void normalize(const float* in, float* out) const;
   // Replaces the statistics, as if `count` rows with this mean and variance had been seen.
   void set(const std::vector<double>& mean, const std::vector<double>& var, double count);
+  // Inputs in [begin, end) always normalise to 0, so a network fed from here never sees
+  // them (the reference's primitives saw the walker's observation without qacc). Saved
+  // with the statistics; the exported policy carries it as inv_std = 0.
+  void ignore(int begin, int end);
+  bool ignored(int j) const { return ignored_[j] != 0; }
   int dim() const { return static_cast<int>(mean_.size()); }
   double count() const { return count_; }
   const std::vector<double>& mean() const { return mean_; }
@@ -33,6 +38,7 @@ class RunningMeanStd {
   std::vector<double> batch_mean_, batch_var_;  // scratch: update() allocates nothing
   std::vector<double> mean_, var_;
   std::vector<float> mean_f_, inv_std_;
+  std::vector<uint8_t> ignored_;
   double count_ = 0.0;
   double clip_, eps_;
 };

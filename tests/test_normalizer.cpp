@@ -2,8 +2,10 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <sstream>
 
 #include "core/rng.h"
+#include "core/error.h"
 #include "core/running_mean_std.h"
 
 namespace segue {
@@ -48,6 +50,36 @@ TEST(RunningMeanStd, NormalizeScalesAndClips) {
   with_eps.normalize(in, out);
   EXPECT_NEAR(out[0], 2.0, 1e-5);   // two standard deviations
   EXPECT_FLOAT_EQ(out[1], 5.0f);    // (1000-10)/sqrt(1e-8) clipped to the bound
+}
+
+TEST(RunningMeanStd, IgnoredInputsNormaliseToZeroAndTheMaskIsSaved) {
+  RunningMeanStd rms(3, /*clip=*/5.0, /*eps=*/0.0);
+  rms.ignore(1, 2);
+  std::vector<float> rows{0, 7, 1, 2, -3, 3, 4, 500, 5};  // columns 0 and 2: var 8/3
+  rms.update(rows.data(), 3);
+  float in[3] = {3, 1e6f, 5}, out[3];
+  rms.normalize(in, out);
+  EXPECT_NEAR(out[0], 1.0 / std::sqrt(8.0 / 3.0), 1e-6);
+  EXPECT_EQ(out[1], 0.0f);             // any value of an ignored input
+  EXPECT_NEAR(out[2], 2.0 / std::sqrt(8.0 / 3.0), 1e-6);
+  EXPECT_EQ(rms.inv_std()[1], 0.0f);   // what an exported policy multiplies it by
+  EXPECT_NEAR(rms.mean()[1], 504.0 / 3, 1e-9);  // statistics are still kept
+
+  torch::serialize::OutputArchive ar;
+  rms.save(ar, "n_");
+  std::stringstream bytes;
+  ar.save_to(bytes);
+  torch::serialize::InputArchive back;
+  back.load_from(bytes);
+  RunningMeanStd loaded(3, 5.0, 0.0);  // built without a mask: the saved one is restored
+  loaded.load(back, "n_");
+  EXPECT_TRUE(loaded.ignored(1));
+  EXPECT_FALSE(loaded.ignored(0) || loaded.ignored(2));
+  float again[3];
+  loaded.normalize(in, again);
+  EXPECT_EQ(again[1], 0.0f);
+  EXPECT_FLOAT_EQ(again[0], out[0]);
+  EXPECT_THROW(rms.ignore(2, 4), Error);
 }
 
 }  // namespace segue

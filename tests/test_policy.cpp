@@ -76,6 +76,44 @@ TEST_F(PolicyFiles, TorchScriptExportRoundTrip) {
   }
 }
 
+// policy.ignore_obs: the trained policy, its checkpoint and its TorchScript all act the
+// same whatever the ignored inputs (here the walker's qacc) hold.
+TEST_F(PolicyFiles, IgnoredInputsDoNotMoveTheActionInAnyExport) {
+  Recipe r = Recipe::parse("{}", "test");
+  VectorEnv envs(task_factory("walker_forward", r.root().sub("env")), 4, 1);
+  PpoConfig cfg;
+  cfg.num_envs = 4;
+  cfg.steps_per_env = 64;
+  cfg.minibatch_size = 64;
+  cfg.epochs = 2;
+  ActorCriticSpec spec;
+  spec.obs_dim = 26;
+  spec.act_dim = 6;
+  spec.ignore_obs = {17, 26};
+  PPO ppo(cfg, spec, envs, 11);
+  ppo.iterate();
+  ppo.policy().export_torchscript(path("p.pt"));
+  ppo.save(path("ckpt.pt"));
+  torch::manual_seed(2);
+  auto obs = torch::randn({5, 26});
+  auto shaken = obs.clone();
+  shaken.narrow(1, 17, 9).normal_().mul_(1000);
+  auto moved = obs.clone();
+  moved.narrow(1, 0, 17).add_(1.0);
+  for (const char* file : {"p.pt", "ckpt.pt"}) {
+    Policy p = Policy::load(path(file));
+    std::vector<float> a(30), b(30), c(30);
+    p.act(obs.data_ptr<float>(), 5, a.data());
+    p.act(shaken.data_ptr<float>(), 5, b.data());
+    p.act(moved.data_ptr<float>(), 5, c.data());
+    EXPECT_EQ(a, b) << file;
+    EXPECT_NE(a, c) << file;  // the inputs it does see still matter
+  }
+  torch::jit::Module m = torch::jit::load(path("p.pt"));
+  auto ts = m.forward({obs}).toTensor(), ts_shaken = m.forward({shaken}).toTensor();
+  EXPECT_TRUE(torch::equal(ts, ts_shaken));
+}
+
 TEST_F(PolicyFiles, RefusesMismatchedAndMissingPolicies) {
   EXPECT_THROW(Policy::load(path("absent.pt")), Error);
   std::ofstream(path("junk.pt")) << "not a model";

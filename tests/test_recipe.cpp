@@ -117,6 +117,8 @@ TEST_F(CliErrors, BadRecipes) {
   std::filesystem::remove_all(dir_ / "start_run");  // the refused run's folder, recipe and all
   auto wider = write("wider.yaml", "task: walker_forward\ninit_policy: assets/policies/walker/walker_jump.pt\n" + in_tmp);
   expect_one_line_error(run("train " + wider), "key 'init_policy': 'assets/policies/walker/walker_jump.pt': policy takes obs_dim 28");
+  auto ignore = write("ignore.yaml", "task: walker_forward\npolicy: {ignore_obs: [17, 30]}\n");
+  expect_one_line_error(run("train " + ignore), "key 'policy.ignore_obs': must be [begin, end) with 0 <= begin < end <= 26");
   auto curbs = write("curbs.yaml", "task: walker_jump\nenv: {curbs: 0}\n");
   expect_one_line_error(run("train " + curbs), "key 'env.curbs': must be at least 1");
 }
