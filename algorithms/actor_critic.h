@@ -15,7 +15,7 @@ struct ActorCriticSpec {
   Activation activation = Activation::Tanh;
   double init_log_std = -0.5;
   // [begin, end) of the observation that neither network sees (the normaliser maps it to
-  // 0); empty = none. The reference's walker primitives saw no qacc: [17, 26].
+  // 0); empty = none. E.g. the walker's qacc, [17, 26] (walker_jump_noqacc.yaml).
   std::vector<int> ignore_obs;
 };
 

@@ -17,7 +17,7 @@ class RunningMeanStd {
   // Replaces the statistics, as if `count` rows with this mean and variance had been seen.
   void set(const std::vector<double>& mean, const std::vector<double>& var, double count);
   // Inputs in [begin, end) always normalise to 0, so a network fed from here never sees
-  // them (the reference's primitives saw the walker's observation without qacc). Saved
+  // them (policy.ignore_obs, e.g. the walker's qacc). Saved
   // with the statistics; the exported policy carries it as inv_std = 0.
   void ignore(int begin, int end);
   bool ignored(int j) const { return ignored_[j] != 0; }
