@@ -45,7 +45,7 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   s.eval_seed = ev.get<uint64_t>("seed", s.eval_seed);
   s.eval_make_env = s.make_env;
   if (ev.get("reference_task", false))
-    s.eval_make_env = task_factory(s.task, Recipe::parse("{}", "reference " + s.task).root());
+    s.eval_make_env = reference_task_factory(s.task);
   if (s.checkpoint_every <= 0) throw root.error("checkpoint_every", "must be positive");
   auto probe = s.make_env();
   s.net.obs_dim = probe->spec().obs_dim;

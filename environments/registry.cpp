@@ -164,4 +164,8 @@ std::vector<std::string> task_names() {
   return names;
 }
 
+std::function<std::unique_ptr<Env>()> reference_task_factory(const std::string& task) {
+  return task_factory(task, Recipe::parse("{}", "reference " + task).root());
+}
+
 }  // namespace segue

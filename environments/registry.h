@@ -13,6 +13,8 @@ namespace segue {
 // Reads the task's settings from `env` (so unknown keys can be refused afterwards) and
 // returns a factory for independent copies. Throws segue::Error for an unknown task.
 std::function<std::unique_ptr<Env>()> task_factory(const std::string& task, const Section& env);
+// The task with every setting at its reference value.
+std::function<std::unique_ptr<Env>()> reference_task_factory(const std::string& task);
 std::vector<std::string> task_names();
 
 }  // namespace segue

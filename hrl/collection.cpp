@@ -6,6 +6,7 @@
 
 #include "core/rng.h"
 #include "core/run_dir.h"
+#include "environments/registry.h"
 
 namespace segue {
 
@@ -45,6 +46,10 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
     // A late interval is reached only as often as every earlier hand-over succeeds.
     if ((e + 1) % 1000 == 0)
       spdlog::info("  S_a: {}/{} states after {} episodes (at most {})", out.size(), count, e + 1, max_episodes);
+    if (out.size() == 0 && e + 1 == kEmptyEpisodes) {
+      max_episodes = e + 1;
+      break;
+    }
   }
   if (out.size() < count)
     throw Error(r.file + ": transition " + r.transition_name(transition) + " was entered only " +
@@ -55,11 +60,17 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
 
 Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, int count, uint64_t seed,
                                       int max_episodes, const std::atomic<int>* stop) {
-  auto env = r.make_env();
-  const EnvSpec& spec = env->spec();
   const Transition& tr = r.meta.transitions().at(transition);
+  const bool own_task = !tr.expert_task.empty();
+  auto env = own_task ? reference_task_factory(tr.expert_task)() : r.make_env();
+  const EnvSpec& spec = env->spec();
   Skill b = r.skills[tr.to];
   const int D = b.obs_end - b.obs_begin;
+  // On its own sub-task (checked at load to have D numbers) pi_b sees all of them.
+  if (own_task) {
+    b.obs_begin = 0;
+    b.obs_end = D;
+  }
   std::vector<float> obs(spec.obs_dim), act(spec.act_dim), prev(D);
   std::vector<double> f(spec.feature_names.size());
   Demonstrations out;
@@ -68,10 +79,10 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {
     if (stop && stop->load()) return out;
     env->reset(mix_seed(seed, e), obs.data());
-    bool entered = false;
-    for (bool done = false; !done && out.size() < count;) {
-      env->features(f.data());
-      bool inside = MetaController::holds(tr.expert_when, f.data());
+    bool entered = false, done = false;
+    for (int t = 0; !done && out.size() < count; ++t) {
+      if (!own_task) env->features(f.data());
+      bool inside = own_task ? t < tr.expert_steps : MetaController::holds(tr.expert_when, f.data());
       if (entered && !inside) break;  // past the window: this episode has nothing more
       entered |= inside;
       std::copy(obs.begin() + b.obs_begin, obs.begin() + b.obs_end, prev.begin());
@@ -85,10 +96,15 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
         out.done.push_back(sr.terminated);
       }
     }
+    if (out.size() == 0 && e + 1 == kEmptyEpisodes) {
+      max_episodes = e + 1;
+      break;
+    }
   }
   if (out.size() < count)
-    throw Error(r.file + ": pi_b of transition " + std::to_string(transition) + " gave only " +
-                std::to_string(out.size()) + " demonstration steps in " + std::to_string(max_episodes) + " episodes");
+    throw Error(r.file + ": pi_b of transition " + r.transition_name(transition) + " gave only " +
+                std::to_string(out.size()) + " demonstration steps in " + std::to_string(max_episodes) +
+                " episodes (T_b: pi_b's steps inside its expert window, in episodes it runs alone)");
   return out;
 }
 

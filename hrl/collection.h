@@ -36,11 +36,14 @@ struct Demonstrations {
 };
 
 // Runs seeded episodes (episode i from mix_seed(seed, i)) until `count` items are found;
-// throws segue::Error if `max_episodes` pass without enough.
+// throws segue::Error if `max_episodes` pass without enough, or as soon as
+// kEmptyEpisodes pass without a single one (a window the episodes never reach: say so
+// at once rather than after max_episodes).
 // `trained`: per transition of the recipe, its pi_ab and q_ab where already trained (or
 // empty). Episodes use q_ab where there is one, else switch at the interval's end.
 // `stop` (a signal's flag): when set, both return at the next episode with what they have.
 constexpr int kStartStateEpisodes = 20000, kDemonstrationEpisodes = 100000;  // default max_episodes
+constexpr int kEmptyEpisodes = 1000;
 StartStates collect_start_states(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
                                  const std::vector<TransitionArtefacts>& trained = {},
                                  int max_episodes = kStartStateEpisodes, const std::atomic<int>* stop = nullptr);

@@ -27,6 +27,23 @@ CompositeRecipe CompositeRecipe::load(const std::string& file, const std::vector
   c.spec = c.make_env()->spec();
   c.skills = read_skills(root.sub("skills"), c.spec);
   c.meta = MetaController(root, c.skills, c.spec.feature_names);
+  const auto items = root.items("transitions");
+  for (size_t t = 0; t < c.meta.transitions().size(); ++t) {
+    const Transition& tr = c.meta.transitions()[t];
+    if (tr.expert_task.empty()) continue;
+    Section e = items[t].sub("expert");
+    std::unique_ptr<Env> own;
+    try {
+      own = reference_task_factory(tr.expert_task)();
+    } catch (const Error& err) {
+      throw e.error("task", err.what());
+    }
+    const Skill& b = c.skills[tr.to];
+    if (own->spec().obs_dim != b.obs_end - b.obs_begin)
+      throw e.error("task", "'" + tr.expert_task + "' has obs_dim " + std::to_string(own->spec().obs_dim) +
+                                ", but skill '" + b.name + "' sees " + std::to_string(b.obs_end - b.obs_begin) +
+                                " numbers of this task");
+  }
   Section methods = root.sub("methods");
   if (methods.has("single")) c.single_policy = methods.sub("single").require<std::string>("policy");
   c.transitions_dir = methods.get<std::string>("transitions", "");

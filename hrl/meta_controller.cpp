@@ -43,8 +43,21 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
     start_.push_back({find_skill(rule, "skill", skills), read_when(rule, features)});
   if (start_.empty()) throw root.error("start", "lists no start skill");
   for (const Section& t : root.items("transitions")) {
-    Transition tr{find_skill(t, "from", skills), find_skill(t, "to", skills), read_when(t, features), {}};
-    tr.expert_when = t.has("expert") ? read_when(t.sub("expert"), features) : tr.when;
+    Transition tr;
+    tr.from = find_skill(t, "from", skills);
+    tr.to = find_skill(t, "to", skills);
+    tr.when = tr.expert_when = read_when(t, features);
+    if (t.has("expert")) {
+      Section e = t.sub("expert");
+      tr.expert_task = e.get<std::string>("task", "");
+      if (tr.expert_task.empty()) {
+        tr.expert_when = read_when(e, features);
+      } else {
+        if (e.has("when")) throw e.error("when", "applies to this task's features; with expert.task give expert.steps");
+        tr.expert_steps = e.require<int>("steps");
+        if (tr.expert_steps <= 0) throw e.error("steps", "must be positive");
+      }
+    }
     transitions_.push_back(tr);
   }
 }

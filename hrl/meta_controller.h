@@ -30,6 +30,11 @@ struct Transition {
   // Where pi_b's own demonstrations T_b are recorded: in episodes that pi_b runs from the
   // start, while these hold (`expert: {when: ...}`; by default the interval itself).
   std::vector<Condition> expert_when;
+  // Or, where pi_b alone never reaches the interval in this task (the crawl falls in the
+  // open before the first ceiling): the first expert_steps steps of pi_b's episodes on its
+  // own sub-task (`expert: {task: walker_crawl, steps: 100}`), as the paper records T_b.
+  std::string expert_task;
+  int expert_steps = 0;
 };
 
 class MetaController {

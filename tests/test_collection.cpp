@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 
 #include "core/assets.h"
+#include "environments/registry.h"
 #include "hrl/collection.h"
 #include "tests/temp_dir.h"
 
@@ -154,6 +157,65 @@ TEST(TransitionEnv, EpisodesStartInSaAndEndWithTheInterval) {
     env.features(f.data());
     if (sr.truncated) EXPECT_FALSE(MetaController::holds(t.when, f.data()));  // left the interval
     EXPECT_LE(steps, 101);  // since_turn runs 0..100 from the start state
+  }
+}
+
+// expert.task: T_b from pi_b's own sub-task, its first expert.steps steps of each episode.
+TEST(Collection, DemonstrationsFromTheSkillsOwnTaskAreItsFirstSteps) {
+  CompositeRecipe r = CompositeRecipe::load(CompositeRecipe::default_file("obstacle_course"));
+  const int t = 1;  // walk -> crawl
+  ASSERT_EQ(r.transition_name(t), "walk-crawl");
+  ASSERT_EQ(r.meta.transitions()[t].expert_task, "walker_crawl");
+  const int steps = r.meta.transitions()[t].expert_steps;
+  Demonstrations d = collect_demonstrations(r, t, steps + 20, 5);
+  ASSERT_EQ(d.size(), steps + 20);
+  ASSERT_EQ(d.obs_dim, 26);
+  // Episode 0 replayed by hand on the crawl's own task: the first `steps` rows are its
+  // steps, then episode 1 begins at its reset observation.
+  auto env = reference_task_factory("walker_crawl")();
+  const Skill& crawl = r.skills[r.meta.transitions()[t].to];
+  std::vector<float> obs(26), act(6);
+  env->reset(mix_seed(5, 0), obs.data());
+  for (int k = 0; k < steps; ++k) {
+    ASSERT_EQ(std::vector<float>(d.obs.begin() + k * 26, d.obs.begin() + (k + 1) * 26), obs) << "step " << k;
+    crawl.policy.act(obs.data(), 1, act.data());
+    if (env->step(act.data(), obs.data()).done()) break;
+  }
+  env->reset(mix_seed(5, 1), obs.data());
+  EXPECT_EQ(std::vector<float>(d.obs.begin() + steps * 26, d.obs.begin() + (steps + 1) * 26), obs);
+}
+
+TEST_F(CollectionFiles, ExpertWindowsAreCheckedAtLoadAndAfterAThousandEmptyEpisodes) {
+  // The crawl run alone on the course falls in the open before any ceiling is 2-3 m ahead.
+  std::ifstream in(CompositeRecipe::default_file("obstacle_course"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string expert = ", expert: {task: walker_crawl, steps: 150}";
+  ASSERT_NE(text.find(expert), std::string::npos);
+  text.erase(text.find(expert), expert.size());
+  std::ofstream(path("course.yaml")) << text;
+  CompositeRecipe r = CompositeRecipe::load(path("course.yaml"));
+  // The recipe's own checks on expert.task: a task that exists, and one whose observation
+  // is the crawl's (26 numbers; the jump's task has 28).
+  for (const auto& [task, message] : std::vector<std::pair<std::string, std::string>>{
+           {"walker_sideways", "key 'transitions.1.expert.task': unknown task 'walker_sideways'"},
+           {"walker_jump", "key 'transitions.1.expert.task': 'walker_jump' has obs_dim 28, but skill 'crawl' sees 26"}}) {
+    std::string bad = text;
+    const std::string when = "when: {ceiling_ahead: [2, 3]}";
+    bad.insert(bad.find(when) + when.size(), ", expert: {task: " + task + ", steps: 9}");
+    std::ofstream(path("bad.yaml")) << bad;
+    try {
+      CompositeRecipe::load(path("bad.yaml"));
+      ADD_FAILURE() << task;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
+  try {
+    collect_demonstrations(r, 1, 100, 5);
+    FAIL() << "collected demonstrations outside any window";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("transition walk-crawl gave only 0 demonstration steps in 1000 episodes"),
+              std::string::npos) << e.what();
   }
 }
 

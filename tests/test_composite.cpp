@@ -212,4 +212,29 @@ TEST(MetaController, RefusesUnknownSkillsAndFeatures) {
   EXPECT_THROW(MetaController(bad_feature.root(), skills, {"curb_ahead"}), Error);
 }
 
+TEST(MetaController, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
+  std::vector<Skill> skills(2);
+  skills[0].name = "walk";
+  skills[1].name = "crawl";
+  const std::string head = "start: [{skill: walk}]\ntransitions:\n  - {from: walk, to: crawl, when: {ceiling_ahead: [2, 3]}, ";
+  Recipe ok = Recipe::parse(head + "expert: {task: walker_crawl, steps: 150}}", "r.yaml");
+  MetaController meta(ok.root(), skills, {"ceiling_ahead"});
+  EXPECT_EQ(meta.transitions()[0].expert_task, "walker_crawl");
+  EXPECT_EQ(meta.transitions()[0].expert_steps, 150);
+  EXPECT_EQ(meta.transitions()[0].expert_when.size(), 1u);  // unused with a task; the interval
+  auto refused = [&](const std::string& expert, const std::string& message) {
+    Recipe r = Recipe::parse(head + "expert: " + expert + "}", "r.yaml");
+    try {
+      MetaController(r.root(), skills, {"ceiling_ahead"});
+      ADD_FAILURE() << expert;
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()), message);
+    }
+  };
+  refused("{task: walker_crawl}", "r.yaml: missing required key 'transitions.0.expert.steps'");
+  refused("{task: walker_crawl, steps: 0}", "r.yaml: key 'transitions.0.expert.steps': must be positive");
+  refused("{task: walker_crawl, steps: 9, when: {ceiling_ahead: [0, 1]}}",
+          "r.yaml: key 'transitions.0.expert.when': applies to this task's features; with expert.task give expert.steps");
+}
+
 }  // namespace segue
