@@ -37,7 +37,12 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
     save(s, dir + "/start_states.pt");
   }
   if (!exists(dir + "/demonstrations.pt")) {
-    spdlog::info("  collecting T_b: {} steps of pi_b in its own interval", c.demonstrations);
+    const Transition& tr = r.meta.transitions()[t];
+    if (tr.expert_task.empty())
+      spdlog::info("  collecting T_b: {} steps of pi_b in its own interval", c.demonstrations);
+    else
+      spdlog::info("  collecting T_b: {} steps of pi_b, its first {} of each episode on {}", c.demonstrations,
+                   tr.expert_steps, tr.expert_task);
     Demonstrations d = collect_demonstrations(r, t, c.demonstrations, mix_seed(r.pipeline.seed, 2 * t + 1),
                                               kDemonstrationEpisodes, stop);
     if (int sig = signal_of(stop)) return sig;
