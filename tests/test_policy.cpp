@@ -34,25 +34,31 @@ TEST(EigenMlp, EqualsLibTorchForward) {
 class PolicyFiles : public TempDirTest {
  protected:
   PolicyFiles() : TempDirTest("policy") {}
+  // One short PPO iteration on walk forward (a non-trivial normaliser and weights), saved
+  // as p.pt (TorchScript) and ckpt.pt; returns the in-memory policy.
+  Policy train_and_save(const std::vector<int>& ignore_obs = {}) {
+    Recipe r = Recipe::parse("{}", "test");
+    VectorEnv envs(task_factory("walker_forward", r.root().sub("env")), 4, 1);
+    PpoConfig cfg;
+    cfg.num_envs = 4;
+    cfg.steps_per_env = 64;
+    cfg.minibatch_size = 64;
+    cfg.epochs = 2;
+    ActorCriticSpec spec;
+    spec.obs_dim = 26;
+    spec.act_dim = 6;
+    spec.ignore_obs = ignore_obs;
+    PPO ppo(cfg, spec, envs, 11);
+    ppo.iterate();
+    Policy mem = ppo.policy();
+    mem.export_torchscript(path("p.pt"));
+    ppo.save(path("ckpt.pt"));
+    return mem;
+  }
 };
 
 TEST_F(PolicyFiles, TorchScriptExportRoundTrip) {
-  Recipe r = Recipe::parse("{}", "test");
-  auto make = task_factory("walker_forward", r.root().sub("env"));
-  VectorEnv envs(make, 4, 1);
-  PpoConfig cfg;
-  cfg.num_envs = 4;
-  cfg.steps_per_env = 64;
-  cfg.minibatch_size = 64;
-  cfg.epochs = 2;
-  ActorCriticSpec spec;
-  spec.obs_dim = 26;
-  spec.act_dim = 6;
-  PPO ppo(cfg, spec, envs, 11);
-  ppo.iterate();  // non-trivial normaliser and weights
-  Policy mem = ppo.policy();
-  mem.export_torchscript(path("p.pt"));
-  ppo.save(path("ckpt.pt"));
+  Policy mem = train_and_save();
 
   torch::jit::Module m = torch::jit::load(path("p.pt"));
   EXPECT_EQ(m.run_method("obs_dim").toInt(), 26);
@@ -79,21 +85,7 @@ TEST_F(PolicyFiles, TorchScriptExportRoundTrip) {
 // policy.ignore_obs: the trained policy, its checkpoint and its TorchScript all act the
 // same whatever the ignored inputs (here the walker's qacc) hold.
 TEST_F(PolicyFiles, IgnoredInputsDoNotMoveTheActionInAnyExport) {
-  Recipe r = Recipe::parse("{}", "test");
-  VectorEnv envs(task_factory("walker_forward", r.root().sub("env")), 4, 1);
-  PpoConfig cfg;
-  cfg.num_envs = 4;
-  cfg.steps_per_env = 64;
-  cfg.minibatch_size = 64;
-  cfg.epochs = 2;
-  ActorCriticSpec spec;
-  spec.obs_dim = 26;
-  spec.act_dim = 6;
-  spec.ignore_obs = {17, 26};
-  PPO ppo(cfg, spec, envs, 11);
-  ppo.iterate();
-  ppo.policy().export_torchscript(path("p.pt"));
-  ppo.save(path("ckpt.pt"));
+  train_and_save({17, 26});
   torch::manual_seed(2);
   auto obs = torch::randn({5, 26});
   auto shaken = obs.clone();
