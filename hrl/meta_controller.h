@@ -32,7 +32,7 @@ struct Transition {
   std::vector<Condition> expert_when;
   // Or, where pi_b alone never reaches the interval in this task (the crawl falls in the
   // open before the first ceiling): the first expert_steps steps of pi_b's episodes on its
-  // own sub-task (`expert: {task: walker_crawl, steps: 100}`), as the paper records T_b.
+  // own sub-task (`expert: {task: walker_crawl, steps: 150}`).
   std::string expert_task;
   int expert_steps = 0;
 };
