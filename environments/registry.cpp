@@ -83,11 +83,19 @@ Factory walker_crawl(const std::string& name, const Section& env) {
   return [=] { return std::make_unique<WalkerCrawl>(name, w, o, c); };
 }
 
+// The reference's composite tasks push nothing (their prob_apply_force is 0); the pushes
+// belong to the sub-tasks a skill is trained on.
+WalkerConfig composite_defaults(int max_steps) {
+  WalkerConfig wd;
+  wd.max_episode_steps = max_steps;
+  wd.push_prob = 0.0;
+  return wd;
+}
+
 // Hurdle and Obstacle course differ only in their layout defaults.
 Builder walker_course(WalkerCourse::Config defaults, int max_steps) {
   return [defaults, max_steps](const std::string& name, const Section& env) -> Factory {
-    WalkerConfig wd;
-    wd.max_episode_steps = max_steps;
+    const WalkerConfig wd = composite_defaults(max_steps);
     WalkerConfig w = WalkerConfig::read(env, wd);
     ObstacleConfig o = ObstacleConfig::read(env);
     WalkerCourse::Config c = defaults;
@@ -122,9 +130,7 @@ WalkerCourse::Config obstacle_course_layout() {
 }
 
 Factory walker_patrol(const std::string& name, const Section& env) {
-  WalkerConfig wd;
-  wd.max_episode_steps = 10000;
-  WalkerConfig w = WalkerConfig::read(env, wd);
+  WalkerConfig w = WalkerConfig::read(env, composite_defaults(10000));
   WalkerPatrol::Config c;
   c.stone_x = env.get("stone_x", c.stone_x);
   c.max_turns = env.get("max_turns", c.max_turns);

@@ -3,6 +3,8 @@
 // meta-controller walks through the documented skill sequence.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "tests/task_fixture.h"
 #include "environments/walker_course.h"
 #include "hrl/meta_controller.h"
@@ -121,6 +123,31 @@ TEST(Patrol, CountsATurnOncePerStoneAndFlipsDirection) {
   r = step_at(*env, -2.1, obs);
   EXPECT_EQ(r.info.success_count, 2);
   EXPECT_EQ(patrol.direction(), 1);
+}
+
+// The reference's composite tasks apply no pushes (prob_apply_force 0), its sub-tasks do.
+TEST(CompositeTasks, PushNothingWhileTheJumpSubTaskPushes) {
+  auto pushed_steps = [](const std::string& task) {
+    auto env = make_task(task, "{}");
+    auto& m = dynamic_cast<MujocoEnv&>(*env);
+    std::vector<float> obs(env->spec().obs_dim);
+    env->reset(11, obs.data());
+    int pushed = 0;
+    for (int t = 0; t < 200; ++t) {
+      if (env->step(kZero, obs.data()).done()) env->reset(obs.data());
+      double total = 0;
+      for (int i = 0; i < 6 * m.model()->nbody; ++i) total += std::abs(m.data()->xfrc_applied[i]);
+      pushed += total > 0;
+    }
+    return pushed;
+  };
+  EXPECT_EQ(pushed_steps("patrol"), 0);
+  EXPECT_EQ(pushed_steps("hurdle"), 0);
+  EXPECT_EQ(pushed_steps("obstacle_course"), 0);
+  // About 0.2 of 200 steps; a binomial(200, 0.2) lies in [15, 65] but for 1e-6 of seeds.
+  const int jump = pushed_steps("walker_jump");
+  EXPECT_GE(jump, 15);
+  EXPECT_LE(jump, 65);
 }
 
 TEST(MetaController, HurdleSkillSequenceOnAScriptedEpisode) {
