@@ -3,8 +3,11 @@
 // lookahead 2 (the second skill change after the transition begins).
 //   from-sa:    episodes restored from RUN/a-b/start_states.pt (what switch training sees)
 //   in-context: whole With TP episodes, every time the transition begins
+//   switch-at:  from S_a, pi_ab for k steps, then pi_b (switch training's hand-over,
+//               lookahead 2), for k = 0, 10, 20, ... and at the interval's end: where in
+//               the interval a hand-over succeeds most, i.e. what q_ab could gain over With TP
 // Build: cmake --build build --target probe_subtask_success
-// usage: build/probe_subtask_success RECIPE RUN_DIR TRANSITION_INDEX from-sa|in-context N
+// usage: build/probe_subtask_success RECIPE RUN_DIR TRANSITION_INDEX from-sa|in-context|switch-at N
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -15,9 +18,13 @@
 
 using namespace segue;
 
+static std::optional<Policy> c_artefact_policy(const CompositeRecipe& r, const std::string& run, int t) {
+  return load_transition_artefacts(r, repo_path(run), "policy.pt", false).at(t).policy;
+}
+
 int main(int argc, char** argv) {
   if (argc != 6) {
-    std::fprintf(stderr, "usage: %s RECIPE RUN_DIR TRANSITION_INDEX from-sa|in-context N\n", argv[0]);
+    std::fprintf(stderr, "usage: %s RECIPE RUN_DIR TRANSITION_INDEX from-sa|in-context|switch-at N\n", argv[0]);
     return 2;
   }
   const CompositeRecipe r = CompositeRecipe::load(argv[1]);
@@ -37,6 +44,41 @@ int main(int argc, char** argv) {
       // From a's phase: the transition into b is the first skill change, then two more.
       ok += run_subtask(*env, c, r.meta.transitions()[t].from, obs.data(), /*lookahead=*/3, /*max_steps=*/5000);
     }
+  } else if (mode == "switch-at") {
+    StartStates s = load_start_states(run + "/" + r.transition_name(t) + "/start_states.pt");
+    const Transition& tr = r.meta.transitions()[t];
+    const Skill& b = r.skills[tr.to];
+    const Policy pi_ab = *c_artefact_policy(r, run, t);
+    std::vector<double> state, features(env->spec().feature_names.size());
+    std::vector<int> at_k(100, 0), tried_k(100, 0);
+    int end_ok = 0, falls = 0, any_ok = 0, rescued = 0;
+    for (int i = 0; i < n; ++i) {
+      bool some = false, last = false;  // some k succeeded; the last k before the end or fall did
+      for (int k = 0;; k += 10) {
+        s.state(i % s.size(), state);
+        env->restore_state(state, obs.data());
+        bool left = false, fell = false;
+        for (int step = 0; step < k && !left && !fell; ++step) {
+          pi_ab.act(obs.data() + b.obs_begin, 1, act.data());
+          StepResult sr = env->step(act.data(), obs.data());
+          env->features(features.data());
+          fell = sr.terminated;
+          left = sr.truncated || !MetaController::holds(tr.when, features.data());
+        }
+        if (fell) { ++falls, rescued += last; break; }
+        const bool success = run_subtask(*env, c, tr.to, obs.data(), 2, 5000);
+        some = some || success;
+        if (left) { end_ok += success; break; }  // the forced switch: With TP
+        ++tried_k[k / 10], at_k[k / 10] += success, last = success;
+        if (k / 10 == 99) break;
+      }
+      any_ok += some;
+    }
+    std::printf("some k succeeds (a per-start oracle): %d of %d; of the %d falls, a switch at the last k "
+                "before it succeeds in %d\n", any_ok, n, falls, rescued);
+    for (int j = 0; j < 100 && tried_k[j]; ++j) std::printf("switch at %3d: %d of %d\n", 10 * j, at_k[j], tried_k[j]);
+    std::printf("interval end (With TP): %d of %d; %d fell before it\n", end_ok, n - falls, falls);
+    return 0;
   } else {
     for (int e = 0; e < n; ++e) {
       env->reset(uint64_t(777 + e), obs.data());
