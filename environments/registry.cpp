@@ -58,6 +58,12 @@ Factory walker_jump(const std::string& name, const Section& env) {
   j.placement_target = env.get("placement_target", j.placement_target);
   j.placement_width = env.get("placement_width", j.placement_width);
   if (j.placement_width <= 0) throw env.error("placement_width", "must be positive");
+  j.approach_speed = env.get("approach_speed", j.approach_speed);
+  j.approach_from = env.get("approach_from", j.approach_from);
+  j.approach_to = env.get("approach_to", j.approach_to);
+  if (j.approach_speed < 0) throw env.error("approach_speed", "must be >= 0 (0: off)");
+  if (!(j.approach_to >= 0 && j.approach_to < j.approach_from))
+    throw env.error("approach_to", "must be in [0, approach_from)");
   if (env.has("takeoff_zone")) {
     const auto zone = env.get("takeoff_zone", std::vector<double>());
     if (zone.size() != 2 || !(zone[0] < zone[1]) || zone[1] > 0)

@@ -205,10 +205,21 @@ double WalkerJump::placement_reward(int k) {
   return jcfg_.placement_bonus * std::exp(-0.5 * z * z);
 }
 
+double WalkerJump::speed_target(int next) const {
+  if (jcfg_.approach_speed <= 0 || next < 0) return cfg_.target_speed;
+  const double d = obstacles_[next].start - min_x();
+  if (d >= jcfg_.approach_from) return cfg_.target_speed;
+  const double w = std::clamp((jcfg_.approach_from - d) / (jcfg_.approach_from - jcfg_.approach_to), 0.0, 1.0);
+  return cfg_.target_speed + w * (jcfg_.approach_speed - cfg_.target_speed);
+}
+
 StepResult WalkerJump::evaluate(const float* action) {
   StepResult r;
   double v = x_velocity();
   r.reward = walk_reward(v, action, 2.0, jcfg_.height_weight);
+  const double target = speed_target(next_obstacle());
+  if (target != cfg_.target_speed)  // v' about the approach's target instead
+    r.reward += 2.0 * ((target - std::abs(v - target)) - speed_term(v));
   // Bonuses for the trailing foot crossing each curb's start, centre and end.
   const int marks = 3 * int(obstacles_.size());
   while (crossed_ < marks) {

@@ -144,6 +144,13 @@ class WalkerJump : public WalkerObstacleEnv {
     // 0.5 m off gains nothing from a slightly longer or shorter step; the takeoff_zone bonus
     // is flat in the same way. This term rewards every step of the way towards the window.
     double placement_bonus = 0.0, placement_target = -0.8, placement_width = 0.3;
+    // Slow approach (training only; 0 = off): the speed term's target falls linearly from
+    // the walker's target_speed at approach_from metres before the next curb to
+    // approach_speed at approach_to, and stays there until the curb's end. A gait whose
+    // steps are shorter than the clearing window (~0.6 m) always has a footfall inside it,
+    // so when to take off becomes a choice at one footfall, not a lengthening or shortening
+    // of the hops before it (which no stage learnt).
+    double approach_speed = 0.0, approach_from = 3.0, approach_to = 1.5;
   };
   WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
   // Summed depth of the walker's capsules in curb k's box (capsule_depth_in_box): what
@@ -165,6 +172,8 @@ class WalkerJump : public WalkerObstacleEnv {
   double clearance(int foot, double height) const;
   // placement_bonus for curb k's frontmost footfall (0 without one), paid once.
   double placement_reward(int k);
+  // The speed term's target at this step (approach_speed's ramp near a curb).
+  double speed_target(int next) const;
   std::vector<int> walker_capsules_;  // the walker's geoms (all capsules), for depth_in_curb
 
   Config jcfg_;

@@ -284,6 +284,32 @@ TEST(WalkerJump, PlacementBonusPaysTheFrontmostFootfallOnceWhenTheCurbIsDecided)
   EXPECT_NEAR(r[0] - r[1], 0.0, 1e-6);
 }
 
+TEST(WalkerJump, ApproachSpeedRampsTheSpeedTargetDownBeforeTheCurb) {
+  // The walker in the air, 0.5 m up (clear of the 0.4 m curb), moving at 4 m/s: v is above
+  // both 3 and the approach target t, so v' = t - (v - t), and twins differing only in
+  // approach_speed (1, from 3 m to 1.5 m) differ by 2 ((2t - v) - (6 - v)) = 4 (t - 3) with
+  // t = 3 - 2 clamp((3 - d) / 1.5, 0, 1), d = curb start - x after the step (obs[26]).
+  auto step_at = [](double x, const std::string& extra, float* d) {
+    auto env = make_task("walker_jump", "{curb_noise: 0, init_noise: 0, init_random_steps: 0, push_prob: 0" + extra + "}");
+    std::vector<float> obs(28);
+    env->reset(0, obs.data());
+    auto& m = dynamic_cast<MujocoEnv&>(*env);
+    m.mutable_data()->qpos[0] = x, m.mutable_data()->qpos[1] += 0.5, m.mutable_data()->qvel[0] = 4.0;
+    m.forward(obs.data());
+    const double r = env->step(kZero, obs.data()).reward;
+    *d = obs[26];
+    return r;
+  };
+  const std::string approach = ", approach_speed: 1, approach_from: 3, approach_to: 1.5";
+  for (double x : {2.0, 4.5, 5.2, 6.0, 7.1, 7.6}) {
+    float d = 0, d2 = 0;
+    const double diff = step_at(x, approach, &d) - step_at(x, "", &d2);
+    ASSERT_EQ(d, d2);
+    const double w = x > 7.2 ? 0.0 : std::clamp((3.0 - d) / 1.5, 0.0, 1.0);  // past the curb: no target
+    EXPECT_NEAR(diff, 4.0 * (-2.0 * w), 1e-4) << "x " << x << " d " << d;
+  }
+}
+
 TEST(WalkerJump, EpisodeEndsPastX15) {
   auto env = make_task("walker_jump", "{curb_noise: 0, push_prob: 0}");
   std::vector<float> obs(28);
