@@ -18,10 +18,6 @@
 
 using namespace segue;
 
-static std::optional<Policy> c_artefact_policy(const CompositeRecipe& r, const std::string& run, int t) {
-  return load_transition_artefacts(r, repo_path(run), "policy.pt", false).at(t).policy;
-}
-
 int main(int argc, char** argv) {
   if (argc != 6) {
     std::fprintf(stderr, "usage: %s RECIPE RUN_DIR TRANSITION_INDEX from-sa|in-context|switch-at N\n", argv[0]);
@@ -30,8 +26,8 @@ int main(int argc, char** argv) {
   const CompositeRecipe r = CompositeRecipe::load(argv[1]);
   const std::string run = argv[2], mode = argv[4];
   const int t = std::atoi(argv[3]), n = std::atoi(argv[5]);
-  TransitionController c(r.skills, r.meta, load_transition_artefacts(r, repo_path(run), "policy.pt", false),
-                         SwitchRule::IntervalEnd);
+  const auto artefacts = load_transition_artefacts(r, repo_path(run), "policy.pt", false);
+  TransitionController c(r.skills, r.meta, artefacts, SwitchRule::IntervalEnd);
   auto env = r.make_env();
   std::vector<float> obs(env->spec().obs_dim), act(env->spec().act_dim);
   int starts = 0, ok = 0;
@@ -48,9 +44,9 @@ int main(int argc, char** argv) {
     StartStates s = load_start_states(run + "/" + r.transition_name(t) + "/start_states.pt");
     const Transition& tr = r.meta.transitions()[t];
     const Skill& b = r.skills[tr.to];
-    const Policy pi_ab = *c_artefact_policy(r, run, t);
+    Policy pi_ab = *artefacts.at(t).policy;
     std::vector<double> state, features(env->spec().feature_names.size());
-    std::vector<int> at_k(100, 0), tried_k(100, 0);
+    std::vector<int> at_k, tried_k;  // by k / 10
     int end_ok = 0, falls = 0, any_ok = 0, rescued = 0;
     for (int i = 0; i < n; ++i) {
       bool some = false, last = false;  // some k succeeded; the last k before the end or fall did
@@ -69,14 +65,14 @@ int main(int argc, char** argv) {
         const bool success = run_subtask(*env, c, tr.to, obs.data(), 2, 5000);
         some = some || success;
         if (left) { end_ok += success; break; }  // the forced switch: With TP
+        if (tried_k.size() <= size_t(k / 10)) tried_k.push_back(0), at_k.push_back(0);
         ++tried_k[k / 10], at_k[k / 10] += success, last = success;
-        if (k / 10 == 99) break;
       }
       any_ok += some;
     }
     std::printf("some k succeeds (a per-start oracle): %d of %d; of the %d falls, a switch at the last k "
                 "before it succeeds in %d\n", any_ok, n, falls, rescued);
-    for (int j = 0; j < 100 && tried_k[j]; ++j) std::printf("switch at %3d: %d of %d\n", 10 * j, at_k[j], tried_k[j]);
+    for (size_t j = 0; j < tried_k.size(); ++j) std::printf("switch at %3zu: %d of %d\n", 10 * j, at_k[j], tried_k[j]);
     std::printf("interval end (With TP): %d of %d; %d fell before it\n", end_ok, n - falls, falls);
     return 0;
   } else {
