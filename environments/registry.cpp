@@ -22,7 +22,8 @@ Builder walker_walk(double direction) {
 
 Factory walker_balance(const std::string& name, const Section& env) {
   WalkerConfig defaults;
-  defaults.push_force = 400.0;  // the reference pushes harder while balancing
+  defaults.push_force = 400.0;  // the reference pushes harder while balancing,
+  defaults.push_prob = 0.1;     // half as often (its Walker2dBalanceEnv's prob_apply_force)
   defaults.foot_cost = 0.0;     // and has no foot term
   WalkerConfig c = WalkerConfig::read(env, defaults);
   return [=] { return std::make_unique<WalkerBalance>(name, c); };

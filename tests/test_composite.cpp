@@ -125,15 +125,16 @@ TEST(Patrol, CountsATurnOncePerStoneAndFlipsDirection) {
   EXPECT_EQ(patrol.direction(), 1);
 }
 
-// The reference's composite tasks apply no pushes (prob_apply_force 0), its sub-tasks do.
-TEST(CompositeTasks, PushNothingWhileTheJumpSubTaskPushes) {
+// The reference's composite tasks apply no pushes (prob_apply_force 0); its sub-tasks push
+// with probability 0.2 a step, balance with 0.1.
+TEST(CompositeTasks, PushNothingWhileSubTasksPushAtTheReferenceRates) {
   auto pushed_steps = [](const std::string& task) {
     auto env = make_task(task, "{}");
     auto& m = dynamic_cast<MujocoEnv&>(*env);
     std::vector<float> obs(env->spec().obs_dim);
     env->reset(11, obs.data());
     int pushed = 0;
-    for (int t = 0; t < 200; ++t) {
+    for (int t = 0; t < 2000; ++t) {
       if (env->step(kZero, obs.data()).done()) env->reset(obs.data());
       double total = 0;
       for (int i = 0; i < 6 * m.model()->nbody; ++i) total += std::abs(m.data()->xfrc_applied[i]);
@@ -144,10 +145,12 @@ TEST(CompositeTasks, PushNothingWhileTheJumpSubTaskPushes) {
   EXPECT_EQ(pushed_steps("patrol"), 0);
   EXPECT_EQ(pushed_steps("hurdle"), 0);
   EXPECT_EQ(pushed_steps("obstacle_course"), 0);
-  // About 0.2 of 200 steps; a binomial(200, 0.2) lies in [15, 65] but for 1e-6 of seeds.
-  const int jump = pushed_steps("walker_jump");
-  EXPECT_GE(jump, 15);
-  EXPECT_LE(jump, 65);
+  // Binomial(2000, p) within 4.5 standard deviations of 2000 p: the two rates cannot overlap.
+  const int jump = pushed_steps("walker_jump"), balance = pushed_steps("walker_balance");
+  EXPECT_GE(jump, 320);
+  EXPECT_LE(jump, 480);
+  EXPECT_GE(balance, 140);
+  EXPECT_LE(balance, 260);
 }
 
 TEST(MetaController, HurdleSkillSequenceOnAScriptedEpisode) {
