@@ -56,15 +56,20 @@ class WalkerEnv : public MujocoEnv {
   void observe(float* obs) const override;
   // Shared terms: upright + alive - foot - ctrl (velocity and height terms are per task).
   double posture_terms(const float* action) const;
-  // v' for a velocity measured along the task's direction.
-  double speed_term(double v) const { return cfg_.target_speed - std::abs(v - cfg_.target_speed); }
+  // v' = target - |v - target| for a velocity measured along the task's direction.
+  static double speed_term(double v, double target) { return target - std::abs(v - target); }
   // Forward velocity over the last control step.
   double x_velocity() const { return (torso_x() - x_before_) / control_dt(); }
 
   WalkerConfig cfg_;
   // Forward-velocity, height and posture terms shared by walk-like rewards:
-  //   speed_weight v' + upright + alive - height_weight |h* - dh| - foot - ctrl.
-  double walk_reward(double v, const float* action, double speed_weight, double height_weight) const;
+  //   speed_weight v' + upright + alive - height_weight |h* - dh| - foot - ctrl,
+  // v' about target_speed (by default the config's).
+  double walk_reward(double v, const float* action, double speed_weight, double height_weight,
+                     double target_speed) const;
+  double walk_reward(double v, const float* action, double speed_weight, double height_weight) const {
+    return walk_reward(v, action, speed_weight, height_weight, cfg_.target_speed);
+  }
   // The result of a step in a "survive success_steps steps" task.
   StepResult survival_step(double reward, bool ended) const;
 

@@ -216,10 +216,8 @@ double WalkerJump::speed_target(int next) const {
 StepResult WalkerJump::evaluate(const float* action) {
   StepResult r;
   double v = x_velocity();
-  r.reward = walk_reward(v, action, 2.0, jcfg_.height_weight);
-  const double target = speed_target(next_obstacle());
-  if (target != cfg_.target_speed)  // v' about the approach's target instead
-    r.reward += 2.0 * ((target - std::abs(v - target)) - speed_term(v));
+  const int next = next_obstacle();
+  r.reward = walk_reward(v, action, 2.0, jcfg_.height_weight, speed_target(next));
   // Bonuses for the trailing foot crossing each curb's start, centre and end.
   const int marks = 3 * int(obstacles_.size());
   while (crossed_ < marks) {
@@ -234,7 +232,6 @@ StepResult WalkerJump::evaluate(const float* action) {
         if (x_before_ <= at && at < torso_x())
           r.reward += jcfg_.mark_upward_weight * std::clamp(z_velocity(), -2.0, 2.0);
   double x = min_x();
-  int next = next_obstacle();
   if (next >= 0) {
     const Obstacle& curb = obstacles_[next];
     if (x > curb.start - 1.0 && x < curb.end) r.reward += jcfg_.upward_weight * std::max(z_velocity(), 0.0);
