@@ -78,4 +78,40 @@ void EigenMlp::forward(const float* in, int batch, float* out) const {
   Eigen::Map<RowMatrix>(out, batch, out_dim()) = scratch_.back();
 }
 
+size_t EigenMlp::parameter_count() const {
+  size_t n = 0;
+  for (size_t i = 0; i < weights_.size(); ++i) n += weights_[i].size() + biases_[i].size();
+  return n;
+}
+
+std::vector<float> EigenMlp::parameters() const {
+  std::vector<float> theta;
+  theta.reserve(parameter_count());
+  for (size_t i = 0; i < weights_.size(); ++i) {
+    theta.insert(theta.end(), weights_[i].data(), weights_[i].data() + weights_[i].size());
+    theta.insert(theta.end(), biases_[i].data(), biases_[i].data() + biases_[i].size());
+  }
+  return theta;
+}
+
+std::vector<size_t> EigenMlp::input_weight_indices(int begin, int end) const {
+  std::vector<size_t> idx;
+  for (int r = 0; r < int(weights_.front().rows()); ++r)
+    for (int j = begin; j < end; ++j) idx.push_back(size_t(r) * in_dim() + j);
+  return idx;
+}
+
+void EigenMlp::set_parameters(const std::vector<float>& theta) {
+  if (theta.size() != parameter_count())
+    throw Error("network has " + std::to_string(parameter_count()) + " parameters, got " +
+                std::to_string(theta.size()));
+  const float* p = theta.data();
+  for (size_t i = 0; i < weights_.size(); ++i) {
+    std::copy(p, p + weights_[i].size(), weights_[i].data());
+    p += weights_[i].size();
+    std::copy(p, p + biases_[i].size(), biases_[i].data());
+    p += biases_[i].size();
+  }
+}
+
 }  // namespace segue

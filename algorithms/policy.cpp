@@ -31,6 +31,12 @@ void Policy::act(const float* obs, int batch, float* actions) const {
       actions[size_t(b) * k + j] = std::clamp(actions[size_t(b) * k + j], act_low_[j], act_high_[j]);
 }
 
+Policy Policy::with_parameters(const std::vector<float>& theta) const {
+  Policy p = *this;
+  p.mlp_.set_parameters(theta);
+  return p;
+}
+
 void Policy::check_fits(const EnvSpec& spec, const std::string& path, bool prefix) const {
   if ((prefix ? obs_dim() > spec.obs_dim : obs_dim() != spec.obs_dim) || act_dim() != spec.act_dim)
     throw Error(path + ": policy takes obs_dim " + std::to_string(obs_dim()) + " / act_dim " +

@@ -22,6 +22,9 @@ class Policy {
   const EigenMlp& mlp() const { return mlp_; }
   const std::vector<float>& obs_mean() const { return obs_mean_; }
   const std::vector<float>& obs_inv_std() const { return obs_inv_std_; }
+  // The same policy (normaliser, action bounds) with other network parameters, laid out
+  // as EigenMlp::parameters().
+  Policy with_parameters(const std::vector<float>& theta) const;
   // obs: [batch, obs_dim] -> actions: [batch, act_dim]. Allocates only when the batch grows.
   void act(const float* obs, int batch, float* actions) const;
 

@@ -39,6 +39,12 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   }
   s.net.init_log_std = pol.get("init_log_std", s.net.init_log_std);
   s.net.ignore_obs = pol.get("ignore_obs", s.net.ignore_obs);
+  if (root.has("es")) {
+    s.es = EsConfig::read(root.sub("es"));
+    if (s.init_policy.empty()) throw root.error("es", "fine-tunes a trained policy: give init_policy too");
+    for (const char* key : {"ppo", "policy"})
+      if (root.has(key)) throw root.error(key, "does not apply to an evolution-strategy run (key 'es')");
+  }
   s.ppo = PpoConfig::read(root.sub("ppo"));
   Section ev = root.sub("eval");
   s.eval_episodes = ev.get("episodes", s.eval_episodes);

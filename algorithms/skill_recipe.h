@@ -15,6 +15,8 @@
 //            ignore_obs: [17, 26]}   # optional: inputs neither net sees (here the qacc)
 //   ppo: {...}                # see PpoConfig
 //   eval: {episodes: 50, seed: 1000, reference_task: false}
+//   es: {...}                 # instead of ppo: fine-tune init_policy with evolution
+//                             # strategies (see EsConfig); policy and ppo do not apply
 //
 // eval.reference_task: judge the trained skill on the task with every env key at its
 // reference value (a recipe may train on an easier or reshaped version, e.g. a curb
@@ -22,9 +24,11 @@
 #include <cmath>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "algorithms/actor_critic.h"
+#include "algorithms/evolution_strategy.h"
 #include "algorithms/ppo.h"
 #include "core/recipe.h"
 
@@ -55,6 +59,7 @@ struct SkillRecipe {
   std::function<std::unique_ptr<Env>()> eval_make_env;  // make_env, or the reference task
   ActorCriticSpec net;
   PpoConfig ppo;
+  std::optional<EsConfig> es;  // set: the run is an evolution-strategy fine-tuning
 
   // Reads every key (then call recipe.reject_unknown()). `default_run_dir` is used when
   // the recipe names none.

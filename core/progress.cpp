@@ -17,8 +17,8 @@ std::string format_duration(double s) {
   return buf;
 }
 
-Progress::Progress(std::string label, long total, long start)
-    : label_(std::move(label)), total_(total), start_(start), tty_(isatty(STDERR_FILENO)),
+Progress::Progress(std::string label, long total, long start, std::string unit)
+    : label_(std::move(label)), unit_(std::move(unit)), total_(total), start_(start), tty_(isatty(STDERR_FILENO)),
       t0_(std::chrono::steady_clock::now()), last_print_(t0_) {}
 
 void Progress::update(long steps, double ret, double success) {
@@ -29,9 +29,12 @@ void Progress::update(long steps, double ret, double success) {
   double elapsed = std::chrono::duration<double>(now - t0_).count();
   double sps = elapsed > 0 ? (steps - start_) / elapsed : 0.0;
   double eta = sps > 0 ? (total_ - steps) / sps : NAN;
-  std::fprintf(stderr, "%s[%s] step %ld/%ld (%.0f%%)  %.0f steps/s  return %.1f  success %.0f%%  ETA %s%s",
-               tty_ ? "\r\033[K" : "", label_.c_str(), steps, total_, 100.0 * steps / total_, sps,
-               ret, 100.0 * success, format_duration(eta).c_str(), tty_ ? "" : "\n");
+  char rate[48];
+  if (sps >= 10) std::snprintf(rate, sizeof rate, "%.0f %ss/s", sps, unit_.c_str());
+  else std::snprintf(rate, sizeof rate, "%.1f %ss/min", 60 * sps, unit_.c_str());
+  std::fprintf(stderr, "%s[%s] %s %ld/%ld (%.0f%%)  %s  return %.1f  success %.0f%%  ETA %s%s",
+               tty_ ? "\r\033[K" : "", label_.c_str(), unit_.c_str(), steps, total_, 100.0 * steps / total_,
+               rate, ret, 100.0 * success, format_duration(eta).c_str(), tty_ ? "" : "\n");
   std::fflush(stderr);
 }
 

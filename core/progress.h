@@ -1,5 +1,5 @@
 #pragma once
-// The console progress line: steps, steps/s, recent return, ETA. Redrawn in place on a
+// The console progress line: steps (or another unit: generations), rate, recent return, ETA. Redrawn in place on a
 // terminal, printed as plain lines (at most every few seconds) into logs.
 #include <chrono>
 #include <string>
@@ -8,12 +8,12 @@ namespace segue {
 
 class Progress {
  public:
-  Progress(std::string label, long total_steps, long start_steps = 0);
+  Progress(std::string label, long total_steps, long start_steps = 0, std::string unit = "step");
   void update(long steps, double recent_return, double success_rate);
   void finish();
 
  private:
-  std::string label_;
+  std::string label_, unit_;
   long total_, start_;
   bool tty_;
   std::chrono::steady_clock::time_point t0_, last_print_;

@@ -1,5 +1,6 @@
 #include "hrl/evaluation.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/rng.h"
@@ -17,45 +18,47 @@ Summary summarize(const std::vector<double>& xs) {
   return s;
 }
 
-EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_controller, int episodes,
-                    uint64_t seed, int threads) {
-  const int slots = std::max(1, std::min(episodes, 32));
+namespace {
+
+// The episode loop: job j starts from seed seed_of(j) and is played by the controller
+// controller_for(slot, j) returns; up to 32 environments step side by side.
+EvalResult run_jobs(const EnvFactory& make_env, int jobs, const std::function<uint64_t(int)>& seed_of,
+                    const std::function<Controller&(int slot, int job)>& controller_for, int threads) {
+  const int slots = std::max(1, std::min(jobs, 32));
   std::vector<std::unique_ptr<Env>> envs;
-  std::vector<std::unique_ptr<Controller>> controllers;
-  for (int i = 0; i < slots; ++i) {
-    envs.push_back(make_env());
-    controllers.push_back(make_controller());
-  }
+  for (int i = 0; i < slots; ++i) envs.push_back(make_env());
   const EnvSpec& spec = envs[0]->spec();
   const int D = spec.obs_dim, A = spec.act_dim, K = static_cast<int>(spec.metric_names.size());
 
   EvalResult r;
-  r.returns.assign(episodes, 0.0);
-  r.success_counts.assign(episodes, 0.0);
-  r.lengths.assign(episodes, 0.0);
-  r.successes.assign(episodes, 0);
+  r.returns.assign(jobs, 0.0);
+  r.success_counts.assign(jobs, 0.0);
+  r.lengths.assign(jobs, 0.0);
+  r.successes.assign(jobs, 0);
   r.metric_names = spec.metric_names;
-  r.metric_means.assign(K, std::vector<double>(episodes, 0.0));
+  r.metric_means.assign(K, std::vector<double>(jobs, 0.0));
 
   std::vector<float> obs(size_t(slots) * D), act(size_t(slots) * A);
-  std::vector<int> episode_of(slots, -1);  // -1 idle, -2 just finished
+  std::vector<int> job_of(slots, -1);  // -1 idle, -2 just finished
+  std::vector<Controller*> controller(slots, nullptr);
   int next = 0;
   auto start = [&](int s) {
-    episode_of[s] = next < episodes ? next++ : -1;
-    if (episode_of[s] < 0) return;
-    envs[s]->reset(mix_seed(seed, episode_of[s]), &obs[size_t(s) * D]);
-    controllers[s]->reset(*envs[s], &obs[size_t(s) * D]);
+    job_of[s] = next < jobs ? next++ : -1;
+    if (job_of[s] < 0) return;
+    controller[s] = &controller_for(s, job_of[s]);
+    envs[s]->reset(seed_of(job_of[s]), &obs[size_t(s) * D]);
+    controller[s]->reset(*envs[s], &obs[size_t(s) * D]);
   };
   for (int s = 0; s < slots; ++s) start(s);
 
   ThreadPool pool(threads);
   std::function<void(int, int)> step_block = [&](int begin, int end) {
     for (int s = begin; s < end; ++s) {
-      int e = episode_of[s];
+      int e = job_of[s];
       if (e < 0) continue;
       float* o = &obs[size_t(s) * D];
       float* a = &act[size_t(s) * A];
-      controllers[s]->act(*envs[s], o, a);
+      controller[s]->act(*envs[s], o, a);
       StepResult sr = envs[s]->step(a, o);
       r.returns[e] += sr.reward;
       r.lengths[e] += 1;
@@ -64,19 +67,60 @@ EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_co
         r.successes[e] = sr.info.success;
         r.success_counts[e] = sr.info.success_count;
         for (int k = 0; k < K; ++k) r.metric_means[k][e] /= r.lengths[e];
-        episode_of[s] = -2;
+        job_of[s] = -2;
       }
     }
   };
   for (;;) {
     bool any = false;
-    for (int s = 0; s < slots; ++s) any |= episode_of[s] >= 0;
+    for (int s = 0; s < slots; ++s) any |= job_of[s] >= 0;
     if (!any) break;
     pool.parallel_for(slots, step_block);
     for (int s = 0; s < slots; ++s)
-      if (episode_of[s] == -2) start(s);
+      if (job_of[s] == -2) start(s);
   }
   return r;
+}
+
+}  // namespace
+
+double EvalResult::success_rate() const {
+  return successes.empty() ? 0.0 : double(std::count(successes.begin(), successes.end(), 1)) / successes.size();
+}
+
+EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_controller, int episodes,
+                    uint64_t seed, int threads) {
+  std::vector<std::unique_ptr<Controller>> controllers;
+  for (int i = 0, slots = std::max(1, std::min(episodes, 32)); i < slots; ++i)
+    controllers.push_back(make_controller());
+  return run_jobs(
+      make_env, episodes, [seed](int e) { return mix_seed(seed, e); },
+      [&](int slot, int) -> Controller& { return *controllers[slot]; }, threads);
+}
+
+std::vector<EvalResult> evaluate_population(const std::vector<Policy>& candidates, const EnvFactory& make_env,
+                                            int episodes, uint64_t seed, int threads) {
+  const int n = static_cast<int>(candidates.size());
+  std::vector<std::unique_ptr<PolicyController>> playing(std::max(1, std::min(n * episodes, 32)));
+  EvalResult all = run_jobs(
+      make_env, n * episodes, [seed, episodes](int j) { return mix_seed(seed, j % episodes); },
+      [&](int slot, int j) -> Controller& {
+        playing[slot] = std::make_unique<PolicyController>(candidates[j / episodes]);
+        return *playing[slot];
+      },
+      threads);
+  std::vector<EvalResult> out(n);
+  for (int c = 0; c < n; ++c) {
+    EvalResult& r = out[c];
+    const auto b = size_t(c) * episodes, e = b + episodes;
+    r.returns.assign(all.returns.begin() + b, all.returns.begin() + e);
+    r.success_counts.assign(all.success_counts.begin() + b, all.success_counts.begin() + e);
+    r.lengths.assign(all.lengths.begin() + b, all.lengths.begin() + e);
+    r.successes.assign(all.successes.begin() + b, all.successes.begin() + e);
+    r.metric_names = all.metric_names;
+    for (const auto& m : all.metric_means) r.metric_means.emplace_back(m.begin() + b, m.begin() + e);
+  }
+  return out;
 }
 
 EvalResult evaluate_policy(const Policy& policy, const EnvFactory& make_env, int episodes, uint64_t seed,

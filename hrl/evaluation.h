@@ -16,6 +16,7 @@ struct EvalResult {
   std::vector<uint8_t> successes;
   std::vector<std::string> metric_names;
   std::vector<std::vector<double>> metric_means;  // [metric][episode]: per-step mean
+  double success_rate() const;  // the fraction of episodes that succeeded
 };
 
 struct Summary {
@@ -31,5 +32,10 @@ EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_co
 // The common case: one deterministic policy.
 EvalResult evaluate_policy(const Policy& policy, const EnvFactory& make_env, int episodes, uint64_t seed,
                            int threads);
+// Several policies on the same `episodes` seeds (common random numbers: candidate c's
+// episode i starts from mix_seed(seed, i), as evaluate_policy's does), all episodes of
+// all candidates stepped side by side. One EvalResult per candidate, in order.
+std::vector<EvalResult> evaluate_population(const std::vector<Policy>& candidates, const EnvFactory& make_env,
+                                            int episodes, uint64_t seed, int threads);
 
 }  // namespace segue

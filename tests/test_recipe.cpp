@@ -119,6 +119,13 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run("train " + wider), "key 'init_policy': 'assets/policies/walker/walker_jump.pt': policy takes obs_dim 28");
   auto ignore = write("ignore.yaml", "task: walker_forward\npolicy: {ignore_obs: [17, 30]}\n");
   expect_one_line_error(run("train " + ignore), "key 'policy.ignore_obs': must be [begin, end) with 0 <= begin < end <= 26");
+  auto es_alone = write("es.yaml", "task: walker_jump\nes: {pairs: 4}\n");
+  expect_one_line_error(run("train " + es_alone), "es.yaml: key 'es': fine-tunes a trained policy: give init_policy too");
+  auto es_ppo = write("es_ppo.yaml", "task: walker_jump\ninit_policy: p.pt\nes: {pairs: 4}\nppo: {lr: 0.1}\n");
+  expect_one_line_error(run("train " + es_ppo), "key 'ppo': does not apply to an evolution-strategy run (key 'es')");
+  expect_one_line_error(run("train " + es_alone + " --set es.sigma=0"), "key 'es.sigma': must be positive");
+  expect_one_line_error(run("train " + es_alone + " --set es.fitness=speed"), "key 'es.fitness': must be 'success' or 'return'");
+  expect_one_line_error(run("train " + es_alone + " --set 'es.inputs=[28, 26]'"), "key 'es.inputs': must be [begin, end)");
   auto curbs = write("curbs.yaml", "task: walker_jump\nenv: {curbs: 0}\n");
   expect_one_line_error(run("train " + curbs), "key 'env.curbs': must be at least 1");
 }

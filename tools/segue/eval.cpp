@@ -72,7 +72,7 @@ int eval_main(int argc, char** argv) {
   EvalResult r = evaluate(make, controllers, episodes, uint64_t(seed), threads);
 
   Summary ret = summarize(r.returns), count = summarize(r.success_counts);
-  double success = summarize(std::vector<double>(r.successes.begin(), r.successes.end())).mean;
+  double success = r.success_rate();
   if (args.has("json")) {
     std::vector<std::pair<std::string, double>> f{
         {"return_mean", ret.mean},          {"return_std", ret.std},
