@@ -50,6 +50,31 @@ std::vector<double> centred_ranks(const std::vector<double>& fitness) {
   return u;
 }
 
+SearchedParameters::SearchedParameters(Policy start, const std::vector<int>& inputs)
+    : start_(std::move(start)), full_(start_.mlp().parameters()) {
+  if (inputs.empty()) {
+    index_.resize(full_.size());
+    std::iota(index_.begin(), index_.end(), size_t(0));
+  } else {
+    if (inputs.size() != 2 || inputs[0] < 0 || inputs[0] >= inputs[1] || inputs[1] > start_.obs_dim())
+      throw Error("inputs must be [begin, end) within the policy's " + std::to_string(start_.obs_dim()) +
+                  " observation inputs");
+    index_ = start_.mlp().input_weight_indices(inputs[0], inputs[1]);
+  }
+}
+
+std::vector<float> SearchedParameters::initial() const {
+  std::vector<float> theta;
+  for (size_t k : index_) theta.push_back(full_[k]);
+  return theta;
+}
+
+Policy SearchedParameters::policy_at(const std::vector<float>& theta) const {
+  std::vector<float> p = full_;
+  for (size_t i = 0; i < index_.size(); ++i) p[index_[i]] = theta.at(i);
+  return start_.with_parameters(p);
+}
+
 EvolutionStrategy::EvolutionStrategy(const EsConfig& config, std::vector<float> theta, uint64_t seed)
     : cfg_(config), theta_(std::move(theta)), m_(theta_.size(), 0.0), v_(theta_.size(), 0.0), seed_(seed) {}
 

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "algorithms/policy.h"
 #include "core/recipe.h"
 
 namespace segue {
@@ -43,6 +44,22 @@ struct EsConfig {
 // between; ties share the mean of their ranks. Invariant to any increasing transform of
 // the fitness, so a rare large score cannot dominate a generation.
 std::vector<double> centred_ranks(const std::vector<double>& fitness);
+
+// The parameters a run searches: all of a policy's network, or only the first layer's
+// weights from observation inputs [inputs[0], inputs[1]); the rest stay as trained.
+class SearchedParameters {
+ public:
+  // Throws segue::Error when `inputs` lies outside the policy's observation.
+  SearchedParameters(Policy start, const std::vector<int>& inputs);
+  std::vector<float> initial() const;                // the start policy's values
+  Policy policy_at(const std::vector<float>& theta) const;
+  size_t size() const { return index_.size(); }
+
+ private:
+  Policy start_;
+  std::vector<float> full_;     // every parameter of the start policy
+  std::vector<size_t> index_;   // where the searched ones sit in full_
+};
 
 class EvolutionStrategy {
  public:

@@ -132,6 +132,25 @@ TEST(EigenMlp, FlatParametersRoundTripAndChangeTheOutput) {
     for (int j = 3; j < 5; ++j) EXPECT_EQ(theta[idx[2 * r + (j - 3)]], mlp.weights()[0](r, j));
 }
 
+TEST(SearchedParameters, MoveOnlyTheFirstLayerWeightsFromTheGivenInputs) {
+  torch::manual_seed(6);
+  EigenMlp mlp(make_mlp(4, {3}, 2, Activation::Tanh, 1.0), Activation::Tanh);
+  Policy start(mlp, std::vector<float>(4, 0.0f), std::vector<float>(4, 1.0f), 10.0f, {-1, -1}, {1, 1});
+  SearchedParameters all(start, {}), pair(start, {2, 4});
+  EXPECT_EQ(all.initial(), start.mlp().parameters());
+  ASSERT_EQ(pair.size(), 6u);  // 3 hidden units x inputs 2 and 3
+  std::vector<float> theta = pair.initial();
+  for (float& t : theta) t += 1.0f;
+  const std::vector<float> before = start.mlp().parameters(), after = pair.policy_at(theta).mlp().parameters();
+  int moved = 0;
+  for (size_t k = 0; k < before.size(); ++k) moved += after[k] != before[k];
+  EXPECT_EQ(moved, 6);
+  for (int r = 0; r < 3; ++r)
+    for (int j = 0; j < 4; ++j)
+      EXPECT_FLOAT_EQ(pair.policy_at(theta).mlp().weights()[0](r, j), mlp.weights()[0](r, j) + (j >= 2 ? 1.0f : 0.0f));
+  EXPECT_THROW(SearchedParameters(start, {2, 5}), Error);
+}
+
 namespace {
 
 struct ShortWalker {

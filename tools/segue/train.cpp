@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <numeric>
 
 #include <spdlog/spdlog.h>
 
@@ -67,25 +66,14 @@ int train_es(const SkillRecipe& s, const Recipe& recipe, const std::string& reci
              int threads) {
   const EsConfig& cfg = *s.es;
   const Policy start = load_init_policy(s, recipe_path, s.make_env()->spec(), /*prefix=*/false);
-  // The searched parameters: all, or the first layer's weights from es.inputs.
-  std::vector<size_t> searched;
-  if (cfg.inputs.empty()) {
-    searched.resize(start.mlp().parameter_count());
-    std::iota(searched.begin(), searched.end(), size_t(0));
-  } else {
-    if (cfg.inputs[1] > start.obs_dim())
-      throw Error(recipe_path + ": key 'es.inputs': the policy has " + std::to_string(start.obs_dim()) + " inputs");
-    searched = start.mlp().input_weight_indices(cfg.inputs[0], cfg.inputs[1]);
-  }
-  const std::vector<float> full = start.mlp().parameters();
-  std::vector<float> theta0;
-  for (size_t k : searched) theta0.push_back(full[k]);
-  auto policy_at = [&](const std::vector<float>& theta) {
-    std::vector<float> p = full;
-    for (size_t i = 0; i < searched.size(); ++i) p[searched[i]] = theta[i];
-    return start.with_parameters(p);
-  };
-  EvolutionStrategy es(cfg, theta0, s.seed);
+  const SearchedParameters space = [&] {
+    try {
+      return SearchedParameters(start, cfg.inputs);
+    } catch (const Error& e) {
+      throw Error(recipe_path + ": key 'es.inputs': " + e.what());
+    }
+  }();
+  EvolutionStrategy es(cfg, space.initial(), s.seed);
   int64_t env_steps = 0;
   double wall = 0.0;
   if (dir.has_checkpoint()) {
@@ -106,8 +94,8 @@ int train_es(const SkillRecipe& s, const Recipe& recipe, const std::string& reci
   while (es.generation() < cfg.generations) {
     auto t0 = std::chrono::steady_clock::now();
     std::vector<Policy> candidates;
-    for (const auto& theta : es.ask()) candidates.push_back(policy_at(theta));
-    candidates.push_back(policy_at(es.theta()));  // the centre, for the log only
+    for (const auto& theta : es.ask()) candidates.push_back(space.policy_at(theta));
+    candidates.push_back(space.policy_at(es.theta()));  // the centre, for the log only
     const uint64_t seed = es.episode_seed();
     std::vector<EvalResult> results = evaluate_population(candidates, s.make_env, cfg.episodes, seed, threads);
     std::vector<double> fitness;
@@ -128,7 +116,7 @@ int train_es(const SkillRecipe& s, const Recipe& recipe, const std::string& reci
     env_steps += int64_t(steps);
     wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     es.save(dir.checkpoint(), recipe.resolved_yaml(), {env_steps, int64_t(wall * 1000)});
-    policy_at(es.theta()).export_torchscript(dir.file("policy.pt"));
+    space.policy_at(es.theta()).export_torchscript(dir.file("policy.pt"));
     csv.write({double(es.generation()), double(env_steps), centre_success, summarize(centre.returns).mean,
                mean_success, best, mean_return, grad, wall});
     progress.update(es.generation(), summarize(centre.returns).mean, centre_success);
@@ -141,7 +129,7 @@ int train_es(const SkillRecipe& s, const Recipe& recipe, const std::string& reci
   }
   progress.finish();
   uninstall_stop_signals();
-  return finish_run(policy_at(es.theta()), s, dir, env_steps, wall, threads);
+  return finish_run(space.policy_at(es.theta()), s, dir, env_steps, wall, threads);
 }
 
 }  // namespace
