@@ -20,11 +20,14 @@ Summary summarize(const std::vector<double>& xs) {
 
 namespace {
 
+// Environments stepped side by side for `jobs` episodes; controllers are kept per slot.
+int slot_count(int jobs) { return std::max(1, std::min(jobs, 32)); }
+
 // The episode loop: job j starts from seed seed_of(j) and is played by the controller
-// controller_for(slot, j) returns; up to 32 environments step side by side.
+// controller_for(slot, j) returns, slot < slot_count(jobs).
 EvalResult run_jobs(const EnvFactory& make_env, int jobs, const std::function<uint64_t(int)>& seed_of,
                     const std::function<Controller&(int slot, int job)>& controller_for, int threads) {
-  const int slots = std::max(1, std::min(jobs, 32));
+  const int slots = slot_count(jobs);
   std::vector<std::unique_ptr<Env>> envs;
   for (int i = 0; i < slots; ++i) envs.push_back(make_env());
   const EnvSpec& spec = envs[0]->spec();
@@ -91,7 +94,7 @@ double EvalResult::success_rate() const {
 EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_controller, int episodes,
                     uint64_t seed, int threads) {
   std::vector<std::unique_ptr<Controller>> controllers;
-  for (int i = 0, slots = std::max(1, std::min(episodes, 32)); i < slots; ++i)
+  for (int i = 0; i < slot_count(episodes); ++i)
     controllers.push_back(make_controller());
   return run_jobs(
       make_env, episodes, [seed](int e) { return mix_seed(seed, e); },
@@ -101,7 +104,7 @@ EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_co
 std::vector<EvalResult> evaluate_population(const std::vector<Policy>& candidates, const EnvFactory& make_env,
                                             int episodes, uint64_t seed, int threads) {
   const int n = static_cast<int>(candidates.size());
-  std::vector<std::unique_ptr<PolicyController>> playing(std::max(1, std::min(n * episodes, 32)));
+  std::vector<std::unique_ptr<PolicyController>> playing(slot_count(n * episodes));
   EvalResult all = run_jobs(
       make_env, n * episodes, [seed, episodes](int j) { return mix_seed(seed, j % episodes); },
       [&](int slot, int j) -> Controller& {
