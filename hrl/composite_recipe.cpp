@@ -62,6 +62,11 @@ std::string CompositeRecipe::transition_name(int t) const {
   return skills[tr.from].name + "-" + skills[tr.to].name;
 }
 
+int CompositeRecipe::start_state_count(int t) const {
+  const int own = meta.transitions().at(t).start_states;
+  return own > 0 ? own : pipeline.collect.start_states;
+}
+
 const std::vector<std::string>& method_names() {
   static const std::vector<std::string> names{"single", "without-tp", "tp", "lee", "tp+q"};
   return names;

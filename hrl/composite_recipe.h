@@ -51,6 +51,8 @@ struct CompositeRecipe {
   static std::string default_file(const std::string& task);
   // "from-to", e.g. "walk-jump": the transition's folder name among the artefacts.
   std::string transition_name(int t) const;
+  // |S_a| to collect for transition t: its own `start_states`, else collect.start_states.
+  int start_state_count(int t) const;
 };
 
 // Method names from the paper: single, without-tp, tp, lee, tp+q.

@@ -47,6 +47,8 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
     tr.from = find_skill(t, "from", skills);
     tr.to = find_skill(t, "to", skills);
     tr.when = tr.expert_when = read_when(t, features);
+    tr.start_states = t.get<int>("start_states", 0);
+    if (t.has("start_states") && tr.start_states <= 0) throw t.error("start_states", "must be positive");
     if (t.has("expert")) {
       Section e = t.sub("expert");
       tr.expert_task = e.get<std::string>("task", "");

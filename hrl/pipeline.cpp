@@ -29,8 +29,9 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
             const std::atomic<int>* stop) {
   const CollectConfig& c = r.pipeline.collect;
   if (!exists(dir + "/start_states.pt")) {
-    spdlog::info("  collecting S_a: {} states where the interval begins", c.start_states);
-    StartStates s = collect_start_states(r, t, c.start_states, mix_seed(r.pipeline.seed, 2 * t),
+    const int count = r.start_state_count(t);
+    spdlog::info("  collecting S_a: {} states where the interval begins", count);
+    StartStates s = collect_start_states(r, t, count, mix_seed(r.pipeline.seed, 2 * t),
                                          load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false),
                                          kStartStateEpisodes, stop);
     if (int sig = signal_of(stop)) return sig;

@@ -310,6 +310,18 @@ TEST_F(TransitionTraining, LeeEpisodesEndAtTheTerminationOutputWithPiBsOutcome) 
   }
 }
 
+TEST_F(TransitionTraining, ATransitionsOwnStartStatesOverrideTheCollectSize) {
+  EXPECT_EQ(tiny().start_state_count(0), 12);  // collect.start_states
+  EXPECT_EQ(tiny({"transitions.0.start_states=5"}).start_state_count(0), 5);
+  try {
+    tiny({"transitions.0.start_states=0"});
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'transitions.0.start_states': must be positive"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
   CompositeRecipe r = tiny();
   PipelineOptions o;
