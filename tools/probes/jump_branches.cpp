@@ -14,9 +14,8 @@
 #include <vector>
 
 #include "algorithms/policy.h"
-#include "core/recipe.h"
-#include "environments/registry.h"
 #include "environments/walker_obstacles.h"
+#include "tools/probes/jump_env.h"
 
 using namespace segue;
 
@@ -25,15 +24,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: %s POLICY N SEED D K SIGMA HOLD [key=value ...]\n", argv[0]);
     return 2;
   }
-  std::unique_ptr<Env> env;
-  try {
-    const Recipe settings = Recipe::parse("{}", "probe", std::vector<std::string>(argv + 8, argv + argc));
-    env = task_factory("walker_jump", settings.root())();
-    settings.reject_unknown();
-  } catch (const Error& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
+  const std::unique_ptr<Env> env = jump_env_from_args(8, argc, argv);
   const Policy pi = Policy::load(argv[1]);
   const int n = std::atoi(argv[2]), k = std::atoi(argv[5]), hold = std::atoi(argv[7]);
   const uint64_t seed = std::strtoull(argv[3], nullptr, 10);

@@ -20,9 +20,8 @@
 
 #include "algorithms/policy.h"
 #include "core/mujoco_env.h"
-#include "core/recipe.h"
 #include "environments/walker_obstacles.h"
-#include "environments/registry.h"
+#include "tools/probes/jump_env.h"
 
 using namespace segue;
 
@@ -31,16 +30,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: %s POLICY N SEED [key=value ...]\n", argv[0]);
     return 2;
   }
-  // The env keys, as `segue --set` overrides of an empty task section.
-  std::unique_ptr<Env> env;
-  try {
-    const Recipe settings = Recipe::parse("{}", "probe", std::vector<std::string>(argv + 4, argv + argc));
-    env = task_factory("walker_jump", settings.root())();
-    settings.reject_unknown();
-  } catch (const Error& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
-    return 1;
-  }
+  const std::unique_ptr<Env> env = jump_env_from_args(4, argc, argv);
   auto* walker = dynamic_cast<WalkerJump*>(env.get());
   const MujocoEnv* mj = walker;
   const Policy pi = Policy::load(argv[1]);
