@@ -111,15 +111,15 @@ int train_es(const SkillRecipe& s, const Recipe& recipe, const std::string& reci
     for (const EvalResult& r : results)
       for (double l : r.lengths) steps += l;
     const EvalResult& centre = results.back();
-    const double centre_success = centre.success_rate();
+    const double centre_success = centre.success_rate(), centre_return = summarize(centre.returns).mean;
     const double grad = es.tell(fitness);
     env_steps += int64_t(steps);
     wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     es.save(dir.checkpoint(), recipe.resolved_yaml(), {env_steps, int64_t(wall * 1000)});
     space.policy_at(es.theta()).export_torchscript(dir.file("policy.pt"));
-    csv.write({double(es.generation()), double(env_steps), centre_success, summarize(centre.returns).mean,
-               mean_success, best, mean_return, grad, wall});
-    progress.update(es.generation(), summarize(centre.returns).mean, centre_success);
+    csv.write({double(es.generation()), double(env_steps), centre_success, centre_return, mean_success, best,
+               mean_return, grad, wall});
+    progress.update(es.generation(), centre_return, centre_success);
     if (stop && es.generation() < cfg.generations) {
       progress.finish();
       spdlog::warn("interrupted: checkpoint saved at generation {}; rerun the same command to resume",
