@@ -18,13 +18,18 @@ Policy::Policy(EigenMlp mlp, std::vector<float> mean, std::vector<float> inv_std
     : mlp_(std::move(mlp)), obs_mean_(std::move(mean)), obs_inv_std_(std::move(inv_std)),
       act_low_(std::move(low)), act_high_(std::move(high)), obs_clip_(clip) {}
 
-void Policy::act(const float* obs, int batch, float* actions) const {
-  const int d = obs_dim(), k = act_dim();
-  normalized_.resize(size_t(batch) * d);
+void Policy::normalize(const float* obs, int batch, float* out) const {
+  const int d = obs_dim();
   for (int b = 0; b < batch; ++b)
     for (int j = 0; j < d; ++j)
-      normalized_[size_t(b) * d + j] =
+      out[size_t(b) * d + j] =
           std::clamp((obs[size_t(b) * d + j] - obs_mean_[j]) * obs_inv_std_[j], -obs_clip_, obs_clip_);
+}
+
+void Policy::act(const float* obs, int batch, float* actions) const {
+  const int k = act_dim();
+  normalized_.resize(size_t(batch) * obs_dim());
+  normalize(obs, batch, normalized_.data());
   mlp_.forward(normalized_.data(), batch, actions);
   for (int b = 0; b < batch; ++b)
     for (int j = 0; j < k; ++j)

@@ -25,6 +25,8 @@ class Policy {
   // The same policy (normaliser, action bounds) with other network parameters, laid out
   // as EigenMlp::parameters().
   Policy with_parameters(const std::vector<float>& theta) const;
+  // The network's input: clip((s - mean) * inv_std), [batch, obs_dim] -> [batch, obs_dim].
+  void normalize(const float* obs, int batch, float* out) const;
   // obs: [batch, obs_dim] -> actions: [batch, act_dim]. Allocates only when the batch grows.
   void act(const float* obs, int batch, float* actions) const;
 
