@@ -3,10 +3,11 @@
 // failing approach clears ~1% of the time, too rarely for PPO to learn from. Here search
 // pays that price on purpose: each round, for each of N episodes, the policy runs
 // deterministically until the curb's start is D m ahead; if it then fails, up to K
-// continuations with action noise (std SIGMA, held HOLD steps) are tried, and the first
-// that clears is kept. The cleared episodes (nominal or searched), from reset to their end,
-// are cloned into the policy's mean by regression (the normaliser stays), and the result
-// is scored deterministically on 100 held-out episodes and written to OUT_r<round>.pt.
+// continuations are tried (action noise of std SIGMA held HOLD steps; with SIGMA <= 0,
+// pauses of 1..K steps, see `run`), and the first that clears is kept. The cleared
+// episodes (nominal or searched), from reset to their end, are cloned into the policy's
+// mean by regression (the normaliser stays), and the result is scored deterministically
+// on 100 held-out episodes and written to OUT_r<round>.pt.
 // Build: cmake --build build --target probe_jump_clone
 // usage: build/probe_jump_clone POLICY OUT N SEED D K SIGMA HOLD ROUNDS EPOCHS LR [key=value ...]
 #include <torch/torch.h>
@@ -118,10 +119,13 @@ int main(int argc, char** argv) {
   std::normal_distribution<float> normal(0.f, float(sigma));
 
   // Runs pi from the current state to the episode's end, appending what it saw and did.
-  auto run = [&](const Policy& p, bool noisy, Demos* d) {
+  // Continuation `branch` > 0 perturbs it: with SIGMA > 0 by held noise; with SIGMA <= 0 it
+  // holds pi's first action for `branch` steps (a pause that shifts the gait's phase, tried
+  // from the shortest, so the demonstrated pause is a function of the state).
+  auto run = [&](const Policy& p, int branch, Demos* d) {
     for (int t = 0;; ++t) {
-      p.act(obs.data(), 1, act.data());
-      if (noisy) {
+      if (branch == 0 || sigma > 0 || t == 0 || t > branch) p.act(obs.data(), 1, act.data());
+      if (branch > 0 && sigma > 0) {
         if (t % hold == 0)
           for (auto& z : noise) z = normal(rng);
         for (int i = 0; i < act_dim; ++i) act[i] = std::clamp(act[i] + noise[i], -1.f, 1.f);
@@ -141,7 +145,7 @@ int main(int argc, char** argv) {
     for (int e = 0; e < 100; ++e) {
       env->reset(900000 + e, obs.data());
       const double c = task.obstacles()[0].start;
-      const bool ok = run(p, false, nullptr);
+      const bool ok = run(p, 0, nullptr);
       wins += ok;
       if (c >= 6.75 && c < 7.5) band += 1, band_wins += ok;
     }
@@ -165,14 +169,14 @@ int main(int argc, char** argv) {
       env->save_state(state);
       start_obs = obs;
       Demos rest;
-      if (run(pi, false, &rest)) {
+      if (run(pi, 0, &rest)) {
         ++nominal;
       } else {
         bool found = false;
         for (int b = 0; b < k && !found; ++b, ++tries) {
           rest = Demos{};
           env->restore_state(state, obs.data());
-          found = run(pi, true, &rest);
+          found = run(pi, b + 1, &rest);
         }
         if (!found) continue;
         ++searched;
