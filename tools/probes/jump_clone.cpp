@@ -116,7 +116,7 @@ int main(int argc, char** argv) {
   std::vector<float> obs(obs_dim), act(act_dim), noise(act_dim), start_obs(obs_dim);
   std::vector<double> state;
   std::mt19937_64 rng(seed);
-  std::normal_distribution<float> normal(0.f, float(sigma));
+  std::normal_distribution<float> normal(0.f, sigma > 0 ? float(sigma) : 1.f);  // unused for pauses
 
   // Runs pi from the current state to the episode's end, appending what it saw and did.
   // Continuation `branch` > 0 perturbs it: with SIGMA > 0 by held noise; with SIGMA <= 0 it
