@@ -30,6 +30,10 @@ namespace {
 
 struct Demos {
   std::vector<float> obs, act;
+  void add(const std::vector<float>& o, const std::vector<float>& a) {
+    obs.insert(obs.end(), o.begin(), o.end());
+    act.insert(act.end(), a.begin(), a.end());
+  }
   void append(const Demos& d) {
     obs.insert(obs.end(), d.obs.begin(), d.obs.end());
     act.insert(act.end(), d.act.begin(), d.act.end());
@@ -46,21 +50,19 @@ Policy clone(const Policy& pi, const Demos& d, int epochs, double lr, uint64_t s
   pi.normalize(d.obs.data(), int(n), x.data());
   const torch::Tensor X = torch::from_blob(x.data(), {n, obs_dim}).clone();
   const torch::Tensor Y = torch::from_blob(const_cast<float*>(d.act.data()), {n, act_dim}).clone();
-  std::vector<float> theta = pi.mlp().parameters();
   std::vector<torch::Tensor> ws, bs;
-  size_t at = 0;
-  for (const auto& w : pi.mlp().weights()) {
-    const int64_t rows = w.rows(), cols = w.cols();
-    ws.push_back(torch::from_blob(theta.data() + at, {rows, cols}).clone().requires_grad_());
-    at += rows * cols;
-    bs.push_back(torch::from_blob(theta.data() + at, {rows}).clone().requires_grad_());
-    at += rows;
+  for (size_t i = 0; i < pi.mlp().weights().size(); ++i) {
+    const auto& w = pi.mlp().weights()[i];
+    const auto& b = pi.mlp().biases()[i];
+    ws.push_back(
+        torch::from_blob(const_cast<float*>(w.data()), {w.rows(), w.cols()}).clone().requires_grad_());
+    bs.push_back(torch::from_blob(const_cast<float*>(b.data()), {b.size()}).clone().requires_grad_());
   }
-  const bool tanh = pi.mlp().activation() == Activation::Tanh;
+  const Activation activation = pi.mlp().activation();
   auto mean = [&](torch::Tensor h) {
     for (size_t i = 0; i < ws.size(); ++i) {
       h = torch::addmm(bs[i], h, ws[i].t());
-      if (i + 1 < ws.size()) h = tanh ? torch::tanh(h) : torch::relu(h);
+      if (i + 1 < ws.size()) h = activation == Activation::Tanh ? torch::tanh(h) : torch::relu(h);
     }
     return h;
   };
@@ -84,15 +86,7 @@ Policy clone(const Policy& pi, const Demos& d, int epochs, double lr, uint64_t s
     }
     if (e == 0 || e + 1 == epochs) std::printf("  clone epoch %d: mse %.4f\n", e + 1, sum / n);
   }
-  at = 0;
-  for (size_t i = 0; i < ws.size(); ++i) {
-    for (const torch::Tensor& t : {ws[i], bs[i]}) {
-      const torch::Tensor c = t.detach().contiguous();
-      std::copy(c.data_ptr<float>(), c.data_ptr<float>() + c.numel(), theta.begin() + at);
-      at += c.numel();
-    }
-  }
-  return pi.with_parameters(theta);
+  return pi.with_parameters(EigenMlp(ws, bs, activation).parameters());
 }
 
 }  // namespace
@@ -113,7 +107,7 @@ int main(int argc, char** argv) {
   const uint64_t seed = std::strtoull(argv[4], nullptr, 10);
   const double dist = std::atof(argv[5]), sigma = std::atof(argv[7]), lr = std::atof(argv[11]);
   const int obs_dim = env->spec().obs_dim, act_dim = env->spec().act_dim;
-  std::vector<float> obs(obs_dim), act(act_dim), noise(act_dim), start_obs(obs_dim);
+  std::vector<float> obs(obs_dim), act(act_dim), noise(act_dim);
   std::vector<double> state;
   std::mt19937_64 rng(seed);
   std::normal_distribution<float> normal(0.f, sigma > 0 ? float(sigma) : 1.f);  // unused for pauses
@@ -130,10 +124,7 @@ int main(int argc, char** argv) {
           for (auto& z : noise) z = normal(rng);
         for (int i = 0; i < act_dim; ++i) act[i] = std::clamp(act[i] + noise[i], -1.f, 1.f);
       }
-      if (d) {
-        d->obs.insert(d->obs.end(), obs.begin(), obs.end());
-        d->act.insert(d->act.end(), act.begin(), act.end());
-      }
+      if (d) d->add(obs, act);
       StepResult r = env->step(act.data(), obs.data());
       if (r.done()) return r.info.success;
     }
@@ -161,13 +152,11 @@ int main(int argc, char** argv) {
       bool ended = false;
       while (obs[obs_dim - 2] > dist && !ended) {  // (start - x, end - x) close the observation
         pi.act(obs.data(), 1, act.data());
-        prefix.obs.insert(prefix.obs.end(), obs.begin(), obs.end());
-        prefix.act.insert(prefix.act.end(), act.begin(), act.end());
+        prefix.add(obs, act);
         ended = env->step(act.data(), obs.data()).done();
       }
       if (ended) continue;
       env->save_state(state);
-      start_obs = obs;
       Demos rest;
       if (run(pi, 0, &rest)) {
         ++nominal;
