@@ -26,6 +26,7 @@ PpoConfig PpoConfig::read(const Section& s, PpoConfig c) {
   c.ent_coef = s.get("ent_coef", c.ent_coef);
   c.min_log_std = s.get("min_log_std", c.min_log_std);
   c.noise_repeat = s.get("noise_repeat", c.noise_repeat);
+  c.bound_coef = s.get("bound_coef", c.bound_coef);
   c.max_grad_norm = s.get("max_grad_norm", c.max_grad_norm);
   c.normalize_reward = s.get("normalize_reward", c.normalize_reward);
   c.obs_clip = s.get("obs_clip", c.obs_clip);
@@ -35,6 +36,7 @@ PpoConfig PpoConfig::read(const Section& s, PpoConfig c) {
   if (c.epochs <= 0) throw s.error("epochs", "must be positive");
   if (c.noise_repeat <= 0) throw s.error("noise_repeat", "must be positive");
   if (!(c.lr > 0)) throw s.error("lr", "must be positive");
+  if (!(c.bound_coef >= 0)) throw s.error("bound_coef", "must be >= 0");
   if (!(c.gamma > 0 && c.gamma <= 1)) throw s.error("gamma", "must be in (0, 1]");
   if (!(c.lambda >= 0 && c.lambda <= 1)) throw s.error("lambda", "must be in [0, 1]");
   return c;
@@ -206,6 +208,8 @@ void PPO::update(IterationStats& stats) {
   auto old_logp = torch::from_blob(buf_.log_probs.data(), {M});
   auto adv = torch::from_blob(buf_.advantages.data(), {M});
   auto ret = torch::from_blob(buf_.returns.data(), {M});
+  const auto& spec = envs_.spec();
+  auto low = torch::tensor(spec.act_low), high = torch::tensor(spec.act_high);
   int batches = 0;
   for (int epoch = 0; epoch < cfg_.epochs; ++epoch) {
     auto perm = torch::randperm(M, torch::kLong);
@@ -219,6 +223,7 @@ void PPO::update(IterationStats& stats) {
       auto value = net_->value(o);
       PpoLoss loss = ppo_loss(logp, old_logp.index_select(0, idx), a, value, ret.index_select(0, idx),
                               net_->entropy(), cfg_.clip, cfg_.vf_coef, cfg_.ent_coef);
+      if (cfg_.bound_coef > 0) loss.total = loss.total + cfg_.bound_coef * action_bound_loss(mean, low, high);
       optimizer_->zero_grad();
       loss.total.backward();
       torch::nn::utils::clip_grad_norm_(net_->parameters(), cfg_.max_grad_norm);

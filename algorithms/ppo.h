@@ -40,6 +40,8 @@ struct PpoConfig {
   // over a stance, so a gait's step length is never explored; noise held over a push-off
   // changes it. Each action's marginal is still N(mu, sigma), which PPO's ratio uses.
   int noise_repeat = 1;
+  // Weight of action_bound_loss (ppo_loss.h) in the update; 0 leaves the mean unbounded.
+  double bound_coef = 0.0;
   double max_grad_norm = 0.5;
   bool normalize_reward = true;     // scale rewards by the std of the discounted return
   double obs_clip = 10.0;

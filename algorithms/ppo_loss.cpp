@@ -14,6 +14,12 @@ torch::Tensor value_loss(const torch::Tensor& value, const torch::Tensor& return
   return 0.5 * (value - returns).pow(2).mean();
 }
 
+torch::Tensor action_bound_loss(const torch::Tensor& mean, const torch::Tensor& low,
+                                const torch::Tensor& high) {
+  auto above = torch::relu(mean - high), below = torch::relu(low - mean);
+  return (above.pow(2) + below.pow(2)).sum(-1).mean();
+}
+
 PpoLoss ppo_loss(const torch::Tensor& logp, const torch::Tensor& old_logp, const torch::Tensor& adv,
                  const torch::Tensor& value, const torch::Tensor& returns,
                  const torch::Tensor& entropy, double clip, double vf_coef, double ent_coef) {

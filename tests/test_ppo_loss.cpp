@@ -39,6 +39,22 @@ TEST(PpoLoss, ValueLossAndTotal) {
   EXPECT_NEAR(l.clip_fraction.item<double>(), 0.0, 1e-9);
 }
 
+TEST(PpoLoss, ActionBoundLossByHand) {
+  // Bounds [-1, 1] and [0, 2]. Row 0: 1.5 is 0.5 above, 2.5 is 0.5 above -> 0.25 + 0.25.
+  // Row 1: -3 is 2 below, 1 is inside -> 4. Row 2: inside -> 0. Mean over rows: 4.5 / 3.
+  auto mean = torch::tensor({{1.5, 2.5}, {-3.0, 1.0}, {0.0, 0.0}}, torch::requires_grad());
+  auto low = torch::tensor({-1.0, 0.0}), high = torch::tensor({1.0, 2.0});
+  auto loss = action_bound_loss(mean, low, high);
+  EXPECT_NEAR(loss.item<double>(), 4.5 / 3.0, 1e-6);
+  // Gradient 2 * excursion / rows, pointing back inside; zero within the bounds.
+  loss.backward();
+  auto g = mean.grad();
+  EXPECT_NEAR(g[0][0].item<double>(), 2 * 0.5 / 3, 1e-6);
+  EXPECT_NEAR(g[1][0].item<double>(), -2 * 2.0 / 3, 1e-6);
+  EXPECT_NEAR(g[1][1].item<double>(), 0.0, 1e-9);
+  EXPECT_NEAR(g[2][0].item<double>(), 0.0, 1e-9);
+}
+
 TEST(PpoLoss, GaussianLogProbAndEntropy) {
   ActorCriticSpec spec;
   spec.obs_dim = 3;

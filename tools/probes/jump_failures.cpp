@@ -4,6 +4,8 @@
 // ghost_curbs=true); and where its last two-footed stance before the curb was (mean ankle
 // x minus the curb's start): the take-off point of a hop; and the frontmost footfall before
 // the curb (either foot's ankle x minus the curb's start): the take-off of an alternating run.
+// Also: per action dimension, the fraction of steps whose mean action (before the clamp to
+// the ctrl range) lies outside the range, where exploration noise added to it is clamped away.
 // TRACE=1 prints every step near the curb.
 // Build: cmake --build build --target probe_jump_failures
 // usage: build/probe_jump_failures POLICY N SEED [key=value ...]  (env keys, e.g. curb_height=0.2)
@@ -42,7 +44,10 @@ int main(int argc, char** argv) {
   std::map<std::string, std::vector<double>> stances;  // outcome -> last stances
   std::map<std::string, std::vector<double>> takeoffs;  // outcome -> frontmost footfalls
   std::map<std::string, int> ends;
-  std::vector<float> obs(env->spec().obs_dim), act(env->spec().act_dim);
+  const EnvSpec& spec = env->spec();
+  std::vector<float> obs(spec.obs_dim), act(spec.act_dim), x(spec.obs_dim), mu(spec.act_dim);
+  std::vector<long> outside(spec.act_dim, 0);
+  long total_steps = 0;
   for (int e = 0; e < n; ++e) {
     env->reset(seed + e, obs.data());
     int steps = 0;
@@ -51,6 +56,10 @@ int main(int argc, char** argv) {
     double takeoff = NAN;  // the last foot on the ground before the curb (an alternating gait's take-off)
     for (;;) {
       pi.act(obs.data(), 1, act.data());
+      pi.normalize(obs.data(), 1, x.data());
+      pi.mlp().forward(x.data(), 1, mu.data());
+      for (int j = 0; j < spec.act_dim; ++j) outside[j] += mu[j] < spec.act_low[j] || mu[j] > spec.act_high[j];
+      ++total_steps;
       StepResult r = env->step(act.data(), obs.data());
       ++steps;
       const mjData* d = mj->data();
@@ -103,4 +112,7 @@ int main(int argc, char** argv) {
       std::printf("\n");
     }
   for (auto& kv : ends) std::printf("%-32s %d\n", kv.first.c_str(), kv.second);
+  std::printf("mean action outside the ctrl range, fraction of %ld steps per dimension:", total_steps);
+  for (long k : outside) std::printf(" %.2f", double(k) / double(total_steps));
+  std::printf("\n");
 }
