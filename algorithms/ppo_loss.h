@@ -17,10 +17,11 @@ torch::Tensor clipped_surrogate(const torch::Tensor& logp, const torch::Tensor& 
 torch::Tensor value_loss(const torch::Tensor& value, const torch::Tensor& returns);
 // The mean's excursion outside the action bounds: mean over the batch of
 // sum_j relu(mu_j - high_j)^2 + relu(low_j - mu_j)^2. Actions are clamped to the bounds,
-// so a mean far outside them makes exploration noise a no-op in that dimension (the
-// shipped jump's mean is outside [-1, 1] in 41-81% of its steps, per dimension; see
-// experiments/primitives/walker_jump_bounded.yaml) and PPO can try nothing there. Penalising the excursion (the "bounds loss" of
-// rl_games-style PPO) keeps the deterministic action the same while noise stays live.
+// so a mean far outside them makes exploration noise a no-op in that dimension, and PPO
+// can try nothing there (the shipped jump's mean is outside [-1, 1] in 41-81% of its
+// steps, per dimension; experiments/primitives/walker_jump_bounded.yaml). Penalising the
+// excursion (the "bounds loss" of rl_games-style PPO) keeps the deterministic action the
+// same while the noise stays live.
 torch::Tensor action_bound_loss(const torch::Tensor& mean, const torch::Tensor& low,
                                 const torch::Tensor& high);
 // total = policy + vf_coef value - ent_coef entropy.
