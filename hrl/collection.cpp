@@ -73,28 +73,41 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
   }
   std::vector<float> obs(spec.obs_dim), act(spec.act_dim), prev(D);
   std::vector<double> f(spec.feature_names.size());
-  Demonstrations out;
-  out.obs_dim = D;
-  out.act_dim = spec.act_dim;
+  Demonstrations out, window;  // window: this episode's steps, added to out once kept
+  out.obs_dim = window.obs_dim = D;
+  out.act_dim = window.act_dim = spec.act_dim;
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {
     if (stop && stop->load()) return out;
     env->reset(mix_seed(seed, e), obs.data());
-    bool entered = false, done = false;
-    for (int t = 0; !done && out.size() < count; ++t) {
+    window.obs.clear(), window.act.clear(), window.next_obs.clear(), window.done.clear();
+    bool entered = false, past = false, done = false, succeeded = false;
+    int successes = 0, at_entry = 0;  // the task's success count, now and on entering
+    // With expert_successful a window is seen to its end, then pi_b runs on to its success.
+    for (int t = 0; !done && (tr.expert_successful || out.size() + window.size() < count); ++t) {
       if (!own_task) env->features(f.data());
       bool inside = own_task ? t < tr.expert_steps : MetaController::holds(tr.expert_when, f.data());
-      if (entered && !inside) break;  // past the window: this episode has nothing more
+      past |= entered && !inside;  // one window per episode
+      if (past && (succeeded || !tr.expert_successful)) break;
+      if (!entered && inside) at_entry = successes;
       entered |= inside;
       std::copy(obs.begin() + b.obs_begin, obs.begin() + b.obs_end, prev.begin());
       b.policy.act(prev.data(), 1, act.data());
       StepResult sr = env->step(act.data(), obs.data());
       done = sr.done();
-      if (inside) {
-        out.obs.insert(out.obs.end(), prev.begin(), prev.end());
-        out.act.insert(out.act.end(), act.begin(), act.end());
-        out.next_obs.insert(out.next_obs.end(), obs.begin() + b.obs_begin, obs.begin() + b.obs_end);
-        out.done.push_back(sr.terminated);
+      successes = sr.info.success_count;
+      succeeded |= entered && successes > at_entry;
+      if (inside && !past) {
+        window.obs.insert(window.obs.end(), prev.begin(), prev.end());
+        window.act.insert(window.act.end(), act.begin(), act.end());
+        window.next_obs.insert(window.next_obs.end(), obs.begin() + b.obs_begin, obs.begin() + b.obs_end);
+        window.done.push_back(sr.terminated);
       }
+    }
+    if (succeeded || !tr.expert_successful) {
+      out.obs.insert(out.obs.end(), window.obs.begin(), window.obs.end());
+      out.act.insert(out.act.end(), window.act.begin(), window.act.end());
+      out.next_obs.insert(out.next_obs.end(), window.next_obs.begin(), window.next_obs.end());
+      out.done.insert(out.done.end(), window.done.begin(), window.done.end());
     }
     if (out.size() == 0 && e + 1 == kEmptyEpisodes) {
       max_episodes = e + 1;
@@ -104,7 +117,8 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
   if (out.size() < count)
     throw Error(r.file + ": pi_b of transition " + r.transition_name(transition) + " gave only " +
                 std::to_string(out.size()) + " demonstration steps in " + std::to_string(max_episodes) +
-                " episodes (T_b: pi_b's steps inside its expert window, in episodes it runs alone)");
+                " episodes (T_b: pi_b's steps inside its expert window, in episodes it runs alone" +
+                (tr.expert_successful ? " and then succeeds)" : ")"));
   return out;
 }
 

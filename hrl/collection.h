@@ -6,8 +6,9 @@
 //        the transition policies trained so far (Without TP where there are none): a
 //        later interval is only reached as often as the earlier transitions succeed.
 //   T_b: pi_b's own (s, a, s') inside its interval: episodes that pi_b runs from the start,
-//        recorded while the transition's `expert.when` holds. Observations are in pi_b's
-//        slice of the task observation.
+//        recorded while the transition's `expert.when` holds (with `expert.successful`,
+//        only windows after which pi_b succeeds, so T_b may overshoot its count by part of
+//        a window). Observations are in pi_b's slice of the task observation.
 // Both are stored as tensors in a .pt file (torch.load-able) that later stages read back.
 #include <atomic>
 #include <string>

@@ -52,8 +52,9 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
     if (t.has("expert")) {
       Section e = t.sub("expert");
       tr.expert_task = e.get<std::string>("task", "");
+      tr.expert_successful = e.get<bool>("successful", false);
       if (tr.expert_task.empty()) {
-        tr.expert_when = read_when(e, features);
+        if (e.has("when")) tr.expert_when = read_when(e, features);  // else the interval
       } else {
         if (e.has("when")) throw e.error("when", "applies to this task's features; with expert.task give expert.steps");
         tr.expert_steps = e.require<int>("steps");

@@ -35,6 +35,10 @@ struct Transition {
   // own sub-task (`expert: {task: walker_crawl, steps: 150}`).
   std::string expert_task;
   int expert_steps = 0;
+  // Keep only the windows after which pi_b goes on to succeed (`expert: {successful: true}`):
+  // the states pi_b expects are those it succeeds from. Matters when pi_b itself often
+  // fails (a 38% jump): matching all of its states would match its failures too.
+  bool expert_successful = false;
   // |S_a| for this transition (`start_states: N`); 0 takes collect.start_states. A late
   // interval is reached only as often as every earlier hand-over succeeds, so a recipe
   // may ask for fewer states there rather than run tens of thousands of episodes.

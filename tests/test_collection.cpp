@@ -185,6 +185,53 @@ TEST(Collection, DemonstrationsFromTheSkillsOwnTaskAreItsFirstSteps) {
   EXPECT_EQ(std::vector<float>(d.obs.begin() + steps * 26, d.obs.begin() + (steps + 1) * 26), obs);
 }
 
+// expert.successful: T_b keeps only the windows after which pi_b succeeds. On Hurdle's
+// walk -> jump the window is 3-4 m before the first curb and success is clearing it;
+// the expected T_b is rebuilt by replaying each episode of the jump by hand.
+TEST_F(CollectionFiles, SuccessfulDemonstrationsAreTheWindowsPiBSucceedsFrom) {
+  std::ifstream in(CompositeRecipe::default_file("hurdle"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string line = "{from: walk, to: jump, when: {curb_ahead: [3, 4]}";
+  ASSERT_NE(text.find(line), std::string::npos);
+  text.insert(text.find(line) + line.size(), ", expert: {successful: true}");
+  std::ofstream(path("hurdle.yaml")) << text;
+  CompositeRecipe r = CompositeRecipe::load(path("hurdle.yaml"));
+  const Transition& tr = r.meta.transitions()[0];
+  ASSERT_TRUE(tr.expert_successful);
+  const int count = 300;
+  Demonstrations d = collect_demonstrations(r, 0, count, 11);
+
+  auto env = r.make_env();
+  const Skill& jump = r.skills[tr.to];
+  const int D = jump.obs_end - jump.obs_begin;
+  std::vector<float> obs(env->spec().obs_dim), act(env->spec().act_dim), want;
+  std::vector<double> f(env->spec().feature_names.size());
+  int kept = 0, dropped = 0;
+  for (int e = 0; int(want.size()) < count * D; ++e) {
+    env->reset(mix_seed(11, e), obs.data());
+    std::vector<float> window;
+    bool entered = false, past = false, cleared = false;
+    for (;;) {
+      env->features(f.data());
+      bool inside = MetaController::holds(tr.when, f.data());
+      past |= entered && !inside;
+      if (past && cleared) break;
+      entered |= inside;
+      if (inside && !past)
+        window.insert(window.end(), obs.begin() + jump.obs_begin, obs.begin() + jump.obs_end);
+      jump.policy.act(obs.data() + jump.obs_begin, 1, act.data());
+      StepResult sr = env->step(act.data(), obs.data());
+      cleared |= entered && sr.info.success_count > 0;  // the first curb is the window's
+      if (sr.done()) break;
+    }
+    if (cleared) ++kept, want.insert(want.end(), window.begin(), window.end());
+    else if (entered) ++dropped;
+  }
+  EXPECT_GT(kept, 0);
+  EXPECT_GT(dropped, 0);  // the 38% jump fails from some windows: they are not in T_b
+  EXPECT_EQ(d.obs, want);
+}
+
 TEST_F(CollectionFiles, ExpertWindowsAreCheckedAtLoadAndAfterAThousandEmptyEpisodes) {
   // The crawl run alone on the course falls in the open before any ceiling is 2-3 m ahead.
   std::ifstream in(CompositeRecipe::default_file("obstacle_course"));

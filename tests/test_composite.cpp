@@ -257,6 +257,14 @@ TEST(MetaController, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
       EXPECT_EQ(std::string(e.what()), message);
     }
   };
+  // expert.successful alone keeps the interval as the window.
+  Recipe kept = Recipe::parse(head + "expert: {successful: true}}", "r.yaml");
+  MetaController filtered(kept.root(), skills, {"ceiling_ahead"});
+  ASSERT_EQ(filtered.transitions()[0].expert_when.size(), 1u);
+  EXPECT_EQ(filtered.transitions()[0].expert_when[0].lo, 2.0);
+  EXPECT_EQ(filtered.transitions()[0].expert_when[0].hi, 3.0);
+  EXPECT_TRUE(filtered.transitions()[0].expert_successful);
+  EXPECT_FALSE(meta.transitions()[0].expert_successful);
   refused("{task: walker_crawl}", "r.yaml: missing required key 'transitions.0.expert.steps'");
   refused("{task: walker_crawl, steps: 0}", "r.yaml: key 'transitions.0.expert.steps': must be positive");
   refused("{task: walker_crawl, steps: 9, when: {ceiling_ahead: [0, 1]}}",
