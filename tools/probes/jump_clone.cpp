@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
     }
   };
   // Deterministic success on 100 held-out episodes, and on those whose curb starts in the
-  // band the shipped jump never clears (6.75-7.5 m).
+  // band stage 3's jump never clears (6.75-7.5 m).
   auto score = [&](const Policy& p) {
     int wins = 0, band = 0, band_wins = 0;
     for (int e = 0; e < 100; ++e) {
