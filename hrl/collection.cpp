@@ -79,7 +79,7 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {
     if (stop && stop->load()) return out;
     env->reset(mix_seed(seed, e), obs.data());
-    window.obs.clear(), window.act.clear(), window.next_obs.clear(), window.done.clear();
+    window.clear();
     bool entered = false, past = false, done = false, succeeded = false;
     int successes = 0, at_entry = 0;  // the task's success count, now and on entering
     // With expert_successful a window is seen to its end, then pi_b runs on to its success.
@@ -103,12 +103,7 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
         window.done.push_back(sr.terminated);
       }
     }
-    if (succeeded || !tr.expert_successful) {
-      out.obs.insert(out.obs.end(), window.obs.begin(), window.obs.end());
-      out.act.insert(out.act.end(), window.act.begin(), window.act.end());
-      out.next_obs.insert(out.next_obs.end(), window.next_obs.begin(), window.next_obs.end());
-      out.done.insert(out.done.end(), window.done.begin(), window.done.end());
-    }
+    if (succeeded || !tr.expert_successful) out.append(window);
     if (out.size() == 0 && e + 1 == kEmptyEpisodes) {
       max_episodes = e + 1;
       break;

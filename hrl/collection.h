@@ -34,6 +34,13 @@ struct Demonstrations {
   std::vector<float> obs, act, next_obs;  // [M, obs_dim], [M, act_dim], [M, obs_dim]
   std::vector<uint8_t> done;              // 1 where the episode truly ended
   int size() const { return obs_dim ? int(obs.size() / obs_dim) : 0; }
+  void clear() { obs.clear(), act.clear(), next_obs.clear(), done.clear(); }
+  void append(const Demonstrations& d) {
+    obs.insert(obs.end(), d.obs.begin(), d.obs.end());
+    act.insert(act.end(), d.act.begin(), d.act.end());
+    next_obs.insert(next_obs.end(), d.next_obs.begin(), d.next_obs.end());
+    done.insert(done.end(), d.done.begin(), d.done.end());
+  }
 };
 
 // Runs seeded episodes (episode i from mix_seed(seed, i)) until `count` items are found;
