@@ -9,7 +9,7 @@ namespace segue {
 LeeTransitionEnv::LeeTransitionEnv(const CompositeRecipe& r, int transition, StartStates starts,
                                    int max_subtask_steps)
     : to_(r.meta.transitions().at(transition).to),
-      inner_(r.make_env(), std::move(starts), r.meta.transitions()[transition].when, r.skills[to_].obs_begin,
+      inner_(r.make_env(), std::move(starts), r.meta.transitions()[transition], r.skills[to_].obs_begin,
              r.skills[to_].obs_end),
       max_subtask_steps_(max_subtask_steps),
       pi_b_(r.skills, r.meta, {}, SwitchRule::IntervalEnd) {

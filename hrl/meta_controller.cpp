@@ -49,6 +49,8 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
     tr.when = tr.expert_when = read_when(t, features);
     tr.start_states = t.get<int>("start_states", 0);
     if (t.has("start_states") && tr.start_states <= 0) throw t.error("start_states", "must be positive");
+    tr.max_steps = t.get<int>("max_steps", 0);
+    if (t.has("max_steps") && tr.max_steps <= 0) throw t.error("max_steps", "must be positive");
     if (t.has("expert")) {
       Section e = t.sub("expert");
       tr.expert_task = e.get<std::string>("task", "");
@@ -63,6 +65,10 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
     }
     transitions_.push_back(tr);
   }
+}
+
+bool Transition::running(const double* features, int steps) const {
+  return (max_steps <= 0 || steps < max_steps) && MetaController::holds(when, features);
 }
 
 bool MetaController::holds(const std::vector<Condition>& when, const double* f) {

@@ -43,6 +43,13 @@ struct Transition {
   // interval is reached only as often as every earlier hand-over succeeds, so a recipe
   // may ask for fewer states there rather than run tens of thousands of episodes.
   int start_states = 0;
+  // The interval also ends after this many steps of a transition policy (`max_steps: N`;
+  // 0: no cap). The paper's intervals are places, and an adversarially trained pi_ab can
+  // learn to stay in one for ever (its reward per step need not be negative); the cap
+  // bounds how long the skill after it waits.
+  int max_steps = 0;
+  // Whether a transition policy that has taken `steps` steps in the interval keeps control.
+  bool running(const double* features, int steps) const;
 };
 
 class MetaController {

@@ -93,7 +93,7 @@ int train_transition(const CompositeRecipe& r, int t, const std::string& dir, co
   const Skill& b = r.skills[tr.to];
   StartStates starts = load_start_states(dir + "/start_states.pt");
   VectorEnv envs(
-      [&] { return std::make_unique<TransitionEnv>(r.make_env(), starts, tr.when, b.obs_begin, b.obs_end); },
+      [&] { return std::make_unique<TransitionEnv>(r.make_env(), starts, tr, b.obs_begin, b.obs_end); },
       cfg.ppo.num_envs, o.threads);
   TransitionPolicyTrainer trainer(cfg, envs, load_demonstrations(dir + "/demonstrations.pt"), b.policy,
                                   mix_seed(r.pipeline.seed, 100 + t));
@@ -161,7 +161,20 @@ int train_switch(const CompositeRecipe& r, int t, const std::string& run, const 
     spdlog::info("  q_ab: {}/{} attempts, epsilon {:.2f}, pi_b succeeded in {:.0f}%, switch at step {:.1f}",
                  trainer.attempts_done(), cfg.attempts, s.epsilon, 100 * s.success_rate, s.switch_step);
   }
-  trainer.q_function().export_torchscript(dir + "/q.pt");
+  double margin = 0.0;
+  if (cfg.validation_starts > 0) {
+    MarginChoice c = trainer.choose_margin();
+    // env_steps: the whole stage's, training and this check.
+    MetricsCsv mc(dir + "/margins.csv", {"margin", "held_out_success", "chosen", "env_steps"}, 0);
+    for (size_t m = 0; m < c.margins.size(); ++m) {
+      mc.write({c.margins[m], c.success[m], double(c.margins[m] == c.margin), double(trainer.env_steps())});
+      spdlog::info("  q_ab: margin {:g}: pi_b succeeded from {:.1f}% of {} held-out starts", c.margins[m],
+                   100 * c.success[m], cfg.validation_starts);
+    }
+    margin = c.margin;
+    spdlog::info("  q_ab: switches where Q(switch) > Q(stay) + {:g}", margin);
+  }
+  trainer.q_function(margin).export_torchscript(dir + "/q.pt");
   double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   spdlog::info("  q_ab: {} attempts, {} environment steps in {}", cfg.attempts, trainer.env_steps(),
                format_duration(secs));
@@ -202,7 +215,7 @@ void write_actions(const CompositeRecipe& r, int t, const std::string& dir, int 
         csv << "\n";
         if (env->step(act.data(), obs.data()).done()) break;
         env->features(f.data());
-        if (!MetaController::holds(tr.when, f.data())) break;
+        if (!tr.running(f.data(), step + 1)) break;
       }
     }
   write_file_atomic(dir + "/actions.csv", csv.str());

@@ -1,5 +1,7 @@
 #include "hrl/pipeline_config.h"
 
+#include <cmath>
+
 namespace segue {
 
 CollectConfig CollectConfig::read(const Section& s) {
@@ -55,6 +57,12 @@ SwitchConfig SwitchConfig::read(const Section& s) {
   c.explore_fraction = s.get("explore_fraction", c.explore_fraction);
   c.max_subtask_steps = s.get("max_subtask_steps", c.max_subtask_steps);
   c.lookahead = s.get("lookahead", c.lookahead);
+  c.validation_starts = s.get("validation_starts", c.validation_starts);
+  c.margins = s.get("margins", c.margins);
+  if (c.validation_starts < 0) throw s.error("validation_starts", "must be >= 0");
+  if (c.margins.empty()) throw s.error("margins", "lists no margin");
+  for (double m : c.margins)
+    if (!std::isfinite(m)) throw s.error("margins", "must be finite numbers");
   if (c.lookahead < 1) throw s.error("lookahead", "must be at least 1");
   if (c.batch <= 0) throw s.error("batch", "must be positive");
   if (c.replay < c.batch) throw s.error("replay", "must hold at least one batch");

@@ -66,6 +66,14 @@ struct SwitchConfig {
   // (run_subtask): 1 is the paper's (pi_b reaches its own end); 2 also asks that the
   // episode, carried on With TP, gets through the next skill.
   int lookahead = 1;
+  // The switch margin m: q_ab switches where Q(switch) > Q(stay) + m (the paper: m = 0).
+  // With validation_starts > 0, the last that many states of S_a are held out of training
+  // and m is the one of `margins` whose hand-overs succeed most often from them (ties: the
+  // larger m). A large m (2 > r_s - r_f) never switches before the interval's end: With TP.
+  // Where pi_ab already hands over near the best point, a learnt q_ab's estimation noise
+  // makes it switch early for nothing; the held-out check keeps that from costing.
+  int validation_starts = 0;
+  std::vector<double> margins{0.0, 0.25, 0.5, 1.0, 2.0};
 
   static SwitchConfig read(const Section& s);
 };

@@ -30,6 +30,10 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
       pi_ab_(std::move(pi_ab)), env_(recipe.make_env()),
       after_(recipe.skills, recipe.meta, std::move(trained), SwitchRule::IntervalEnd) {
   if (starts_.size() == 0) throw Error("switch training: S_a is empty");
+  train_starts_ = starts_.size() - cfg_.validation_starts;
+  if (train_starts_ < 1)
+    throw Error("switch training: validation_starts (" + std::to_string(cfg_.validation_starts) +
+                ") leaves none of S_a's " + std::to_string(starts_.size()) + " states to train on");
   const EnvSpec& spec = env_->spec();
   const int D = spec.obs_dim;
   full_.resize(D), next_full_.resize(D), scratch_.resize(D), qvals_.resize(2);
@@ -49,7 +53,7 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
   std::vector<float> act(spec.act_dim);
   std::vector<double> sum(D, 0.0), sq(D, 0.0);
   int64_t rows = 0, steps = 0;
-  const int probes = std::min(20, starts_.size());
+  const int probes = std::min(20, train_starts_);
   for (int p = 0; p < probes; ++p) {
     starts_.state(p, state_);
     env_->restore_state(state_, full_.data());
@@ -60,7 +64,7 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
       StepResult sr = env_->step(act.data(), full_.data());
       env_->features(features_.data());
       ++steps;
-      if (sr.done() || !MetaController::holds(tr_.when, features_.data())) break;
+      if (sr.done() || !tr_.running(features_.data(), t + 1)) break;
     }
   }
   interval_length_ = std::max<int>(1, int(steps / probes));
@@ -105,7 +109,7 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
   const int D = int(full_.size());
   const Skill& b = recipe_.skills[tr_.to];
   std::vector<float> act(env_->spec().act_dim);
-  int i = rng_.integer(0, starts_.size() - 1);
+  int i = rng_.integer(0, train_starts_ - 1);
   starts_.state(i, state_);
   env_->restore_state(state_, full_.data());
   const int switch_at = random ? rng_.integer(0, interval_length_ - 1) : -1;
@@ -121,7 +125,7 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
     StepResult sr = env_->step(act.data(), next_full_.data());
     ++env_steps_;
     env_->features(features_.data());
-    bool left = sr.truncated || !MetaController::holds(tr_.when, features_.data());
+    bool left = sr.truncated || !tr_.running(features_.data(), t + 1);
     if (sr.terminated) {  // a fall while staying
       store(full_.data(), a, cfg_.r_fail, next_full_.data(), true);
       return {false, t + 1};
@@ -177,9 +181,64 @@ SwitchStats SwitchTrainer::run(int n) {
   return s;
 }
 
-Policy SwitchTrainer::q_function() const {
+Policy SwitchTrainer::q_function(double margin) const {
   const float inf = std::numeric_limits<float>::infinity();
-  return Policy(EigenMlp(q_->q, Activation::Relu), mean_, inv_std_, 5.0f, {-inf, -inf}, {inf, inf});
+  EigenMlp net(q_->q, Activation::Relu);
+  std::vector<float> theta = net.parameters();
+  theta[theta.size() - 2 + SwitchQNetworkImpl::kStay] += float(margin);  // the last layer's bias
+  net.set_parameters(theta);
+  return Policy(net, mean_, inv_std_, 5.0f, {-inf, -inf}, {inf, inf});
+}
+
+MarginChoice SwitchTrainer::choose_margin() {
+  MarginChoice c;
+  c.margins = cfg_.margins;
+  std::sort(c.margins.begin(), c.margins.end());
+  c.success.assign(c.margins.size(), 0.0);
+  const Skill& b = recipe_.skills[tr_.to];
+  std::vector<float> act(env_->spec().act_dim);
+  std::vector<std::vector<double>> path;  // the full state at each step of pi_ab's run
+  std::vector<float> gap;                 // Q(switch) - Q(stay) there
+  const int held_out = starts_.size() - train_starts_;
+  for (int i = train_starts_; i < starts_.size(); ++i) {
+    starts_.state(i, state_);
+    env_->restore_state(state_, full_.data());
+    path.clear(), gap.clear();
+    for (int t = 0;; ++t) {
+      path.emplace_back();
+      env_->save_state(path.back());
+      normalize(full_.data(), scratch_.data());
+      q_copy_.forward(scratch_.data(), 1, qvals_.data());
+      gap.push_back(qvals_[SwitchQNetworkImpl::kSwitch] - qvals_[SwitchQNetworkImpl::kStay]);
+      pi_ab_.act(full_.data() + b.obs_begin, 1, act.data());
+      StepResult sr = env_->step(act.data(), full_.data());
+      ++env_steps_;
+      env_->features(features_.data());
+      if (sr.terminated) break;  // a fall: no hand-over point after this one
+      if (sr.truncated || !tr_.running(features_.data(), t + 1)) {  // the forced switch's state
+        path.emplace_back();
+        env_->save_state(path.back());
+        gap.push_back(std::numeric_limits<float>::infinity());
+        break;
+      }
+    }
+    std::vector<int> judged(path.size(), -1);  // pi_b's outcome from each hand-over point
+    for (size_t m = 0; m < c.margins.size(); ++m) {
+      size_t k = 0;
+      while (k < gap.size() && !(gap[k] > c.margins[m])) ++k;
+      if (k == gap.size()) continue;  // pi_ab fell before any hand-over: a failure
+      if (judged[k] < 0) {
+        env_->restore_state(path[k], full_.data());
+        judged[k] = hand_over(full_.data());
+      }
+      c.success[m] += double(judged[k]) / held_out;
+    }
+  }
+  size_t best = 0;
+  for (size_t m = 1; m < c.margins.size(); ++m)
+    if (c.success[m] >= c.success[best]) best = m;
+  c.margin = c.margins[best];
+  return c;
 }
 
 }  // namespace segue

@@ -36,6 +36,12 @@ namespace segue {
 bool run_subtask(Env& env, TransitionController& after, int to_skill, float* obs, int lookahead, int max_steps,
                  int64_t* steps = nullptr);
 
+// The held-out choice of the switch margin (SwitchConfig::validation_starts).
+struct MarginChoice {
+  std::vector<double> margins, success;  // pi_b's success rate from the held-out starts, per margin
+  double margin = 0;                     // the chosen one
+};
+
 struct SwitchStats {
   int attempts = 0;
   double success_rate = 0;   // of pi_b's subtask, over the attempts in this report
@@ -55,8 +61,14 @@ class SwitchTrainer {
   // Environment steps so far: pi_ab's in the interval and pi_b's subtasks after switches.
   int64_t env_steps() const { return env_steps_; }
   // q_ab as a function of the task observation: forward(obs) -> [Q(stay), Q(switch)],
-  // input normalisation included (exported like a policy, with unbounded outputs).
-  Policy q_function() const;
+  // input normalisation included (exported like a policy, with unbounded outputs). The
+  // margin is added to Q(stay), so that the exported rule "switch where Q(switch) >
+  // Q(stay)" is the rule with the margin.
+  Policy q_function(double margin = 0.0) const;
+  // From each held-out start: pi_ab runs through the interval (its path does not depend on
+  // the margin); each margin's hand-over point is the first state where Q(switch) > Q(stay)
+  // + m, else the interval's end; pi_b is judged from each distinct point as in training.
+  MarginChoice choose_margin();
 
  private:
   struct Outcome {
@@ -90,6 +102,7 @@ class SwitchTrainer {
   std::vector<float> reward_, done_;
   int64_t stored_ = 0;
   int attempts_ = 0, updates_ = 0, interval_length_ = 1;
+  int train_starts_ = 0;  // S_a's first train_starts_ states train; the rest are held out
   int64_t env_steps_ = 0;
   std::vector<float> full_, next_full_, scratch_, qvals_;
   std::vector<double> features_, state_;

@@ -34,14 +34,14 @@ void TransitionController::act(const Env& env, const float* obs, float* action) 
   env.features(features_.data());
   if (transition_ >= 0) {
     const Transition& tr = meta_.transitions()[transition_];
-    if (!MetaController::holds(tr.when, features_.data()) || hand_over(obs)) transition_ = -1;
+    if (!tr.running(features_.data(), steps_) || hand_over(obs)) transition_ = -1;
   }
   if (transition_ < 0) {
     int t = meta_.active_transition(skill_, features_.data());
     if (t >= 0) {
       skill_ = meta_.transitions()[t].to;  // pi_b is next, whoever drives the interval
       if (artefacts_[t].policy) {
-        transition_ = t;
+        transition_ = t, steps_ = 0;
         if (hand_over(obs)) transition_ = -1;  // q_ab may switch at the interval's first state
       }
     }
@@ -55,6 +55,7 @@ void TransitionController::act(const Env& env, const float* obs, float* action) 
   const int A = env.spec().act_dim;
   out_.resize(pi_ab.act_dim());
   pi_ab.act(obs + b.obs_begin, 1, out_.data());
+  ++steps_;
   std::copy(out_.begin(), out_.begin() + A, action);
   // Lee et al.: the transition policy's own termination output ends it from the next step.
   if (rule_ == SwitchRule::TerminationHead && pi_ab.act_dim() > A && out_[A] > 0.0f) transition_ = -1;

@@ -6,7 +6,7 @@
 //   QNetwork         (With TP + Q):   as soon as q_ab values switch above stay;
 //   TerminationHead  (Lee et al.):    when pi_ab's extra output (its termination head) is
 //                                     positive.
-// Control always passes to pi_b when the interval ends. A transition without a trained
+// Control always passes to pi_b when the interval ends (or its max_steps are spent). A transition without a trained
 // pi_ab is taken as Without TP.
 #include <optional>
 #include <vector>
@@ -44,7 +44,7 @@ class TransitionController : public Controller {
   SwitchRule rule_;
   std::vector<double> features_;
   std::vector<float> out_;
-  int skill_ = 0, transition_ = -1;
+  int skill_ = 0, transition_ = -1, steps_ = 0;  // steps_: pi_ab's in this interval
 };
 
 }  // namespace segue

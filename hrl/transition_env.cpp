@@ -4,9 +4,9 @@
 
 namespace segue {
 
-TransitionEnv::TransitionEnv(std::unique_ptr<Env> task, StartStates starts, std::vector<Condition> interval,
-                             int obs_begin, int obs_end)
-    : task_(std::move(task)), starts_(std::move(starts)), interval_(std::move(interval)), begin_(obs_begin),
+TransitionEnv::TransitionEnv(std::unique_ptr<Env> task, StartStates starts, Transition transition, int obs_begin,
+                             int obs_end)
+    : task_(std::move(task)), starts_(std::move(starts)), transition_(std::move(transition)), begin_(obs_begin),
       end_(obs_end) {
   if (starts_.size() == 0) throw Error("transition environment: S_a is empty");
   spec_ = task_->spec();
@@ -27,6 +27,7 @@ void TransitionEnv::reset(float* obs) {
   int i = rng_.integer(0, starts_.size() - 1);
   starts_.state(i, state_);
   task_->restore_state(state_, full_.data());
+  steps_ = 0;
   slice(obs);
 }
 
@@ -34,15 +35,18 @@ StepResult TransitionEnv::step(const float* action, float* obs) {
   StepResult r = task_->step(action, full_.data());
   slice(obs);
   task_->features(features_.data());
-  if (!r.terminated && !MetaController::holds(interval_, features_.data())) r.truncated = true;
-  // A transition episode succeeds when it reaches the interval's end on its feet.
-  r.info.success = r.truncated && !r.terminated;
+  const bool left = !MetaController::holds(transition_.when, features_.data());
+  if (!r.terminated && !transition_.running(features_.data(), ++steps_)) r.truncated = true;
+  // A transition episode succeeds when it reaches the interval's end on its feet (not
+  // when max_steps cut it short).
+  r.info.success = left && !r.terminated;
   r.info.success_count = r.info.success;
   return r;
 }
 
 void TransitionEnv::restore_state(const std::vector<double>& state, float* obs) {
   task_->restore_state(state, full_.data());
+  steps_ = 0;
   slice(obs);
 }
 

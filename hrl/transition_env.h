@@ -1,7 +1,7 @@
 #pragma once
 // The environment a transition policy pi_ab trains in (Algorithm 1, lines 8-9): each
 // episode starts from a state sampled from S_a and runs while the transition interval
-// holds. Leaving the interval ends the episode as a time limit (truncated: pi_b takes
+// holds (Transition::running). Leaving the interval ends the episode as a time limit (truncated: pi_b takes
 // over from there); the task ending (a fall) ends it for real. pi_ab sees pi_b's slice
 // of the task observation, the space its discriminator compares with T_b.
 #include <memory>
@@ -14,8 +14,7 @@ namespace segue {
 
 class TransitionEnv : public Env {
  public:
-  TransitionEnv(std::unique_ptr<Env> task, StartStates starts, std::vector<Condition> interval,
-                int obs_begin, int obs_end);
+  TransitionEnv(std::unique_ptr<Env> task, StartStates starts, Transition transition, int obs_begin, int obs_end);
   const EnvSpec& spec() const override { return spec_; }
   void reset(uint64_t seed, float* obs) override;
   void reset(float* obs) override;
@@ -31,8 +30,8 @@ class TransitionEnv : public Env {
   void slice(float* obs) const;
   std::unique_ptr<Env> task_;
   StartStates starts_;
-  std::vector<Condition> interval_;
-  int begin_, end_;
+  Transition transition_;
+  int begin_, end_, steps_ = 0;
   EnvSpec spec_;
   Rng rng_;
   std::vector<float> full_;

@@ -136,7 +136,7 @@ TEST(TransitionEnv, EpisodesStartInSaAndEndWithTheInterval) {
   const Transition& t = r.meta.transitions()[0];  // forward -> balance: since_turn in [0, 100]
   StartStates s = collect_start_states(r, 0, 3, 1);
   const Skill& b = r.skills[t.to];
-  TransitionEnv env(r.make_env(), s, t.when, b.obs_begin, b.obs_end);
+  TransitionEnv env(r.make_env(), s, t, b.obs_begin, b.obs_end);
   EXPECT_EQ(env.spec().obs_dim, 26);
   std::vector<float> obs(26), act(6);
   std::vector<double> f(env.task().spec().feature_names.size());
@@ -157,6 +157,33 @@ TEST(TransitionEnv, EpisodesStartInSaAndEndWithTheInterval) {
     env.features(f.data());
     if (sr.truncated) EXPECT_FALSE(MetaController::holds(t.when, f.data()));  // left the interval
     EXPECT_LE(steps, 101);  // since_turn runs 0..100 from the start state
+  }
+}
+
+// max_steps: the interval also ends after that many of pi_ab's steps, as a time limit.
+TEST(TransitionEnv, MaxStepsEndTheIntervalEarly) {
+  CompositeRecipe r = CompositeRecipe::load(CompositeRecipe::default_file("patrol"), {"env.push_prob=0"});
+  Transition t = r.meta.transitions()[0];  // forward -> balance: since_turn in [0, 100]
+  StartStates s = collect_start_states(r, 0, 3, 1);
+  const Skill& b = r.skills[t.to];
+  auto run = [&](const Transition& tr, uint64_t seed) {
+    TransitionEnv env(r.make_env(), s, tr, b.obs_begin, b.obs_end);
+    std::vector<float> obs(26), act(6);
+    env.reset(seed, obs.data());
+    int steps = 0;
+    StepResult sr;
+    do {
+      b.policy.act(obs.data(), 1, act.data());
+      sr = env.step(act.data(), obs.data());
+      ++steps;
+    } while (!sr.done());
+    return std::make_tuple(steps, sr.truncated, sr.info.success);
+  };
+  t.max_steps = 30;
+  for (uint64_t seed : {100, 101, 102}) {
+    ASSERT_GT(std::get<0>(run(r.meta.transitions()[0], seed)), 30);  // without the cap it runs on
+    // A time limit, not a success: the interval's end was not reached.
+    EXPECT_EQ(run(t, seed), std::make_tuple(30, true, false));
   }
 }
 

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """Ships the transition artefacts of a finished `segue run`: copies RUN_DIR/NAME/{policy,q,lee}.pt
 to assets/policies/<group>/<task>/NAME/ and records what each cost in manifest.json there
-(environment steps and wall time, read from the stage CSVs), and copies RUN_DIR/TASK.md/json
-to experiments/results/.
+(environment steps and wall time, read from the stage CSVs; q_ab's switch margin from
+margins.csv), and copies RUN_DIR/TASK.md/json to experiments/results/.
 
 usage: tools/ship_transitions.py RUN_DIR [--group walker] [--no-results]
 """
@@ -50,6 +50,14 @@ for name in names:
             if stage == "switch":
                 entry[stage]["attempts"] = int(float(row["attempts"]))
                 entry[stage]["subtask_success_last_100"] = float(row["subtask_success"])
+    margins = os.path.join(src, "margins.csv")  # the held-out choice of q_ab's switch margin
+    if os.path.exists(margins) and "switch" in entry:
+        with open(margins) as f:
+            rows = list(csv.DictReader(f))
+        entry["switch"]["held_out_success"] = {f'{float(r["margin"]):g}': float(r["held_out_success"]) for r in rows}
+        entry["switch"]["margin"] = next(float(r["margin"]) for r in rows if float(r["chosen"]))
+        if rows[0].get("env_steps"):  # the stage's steps, the held-out check's included
+            entry["switch"]["env_steps"] = int(float(rows[0]["env_steps"]))
     manifest["transitions"][name] = entry
 with open(os.path.join(out_dir, "manifest.json"), "w") as f:
     json.dump(manifest, f, indent=2, sort_keys=True)
