@@ -6,8 +6,8 @@
 //   QNetwork         (With TP + Q):   as soon as q_ab values switch above stay;
 //   TerminationHead  (Lee et al.):    when pi_ab's extra output (its termination head) is
 //                                     positive.
-// Control always passes to pi_b when the interval ends (or its max_steps are spent). A transition without a trained
-// pi_ab is taken as Without TP.
+// Control always passes to pi_b when the interval ends (or its max_steps are spent). A
+// transition without a trained pi_ab is taken as Without TP.
 #include <optional>
 #include <vector>
 

@@ -131,6 +131,20 @@ TEST(Collection, RefusesATransitionThatIsNeverEntered) {
 
 namespace segue {
 
+// Runs pi_b in `env` from the observation after a reset until the episode ends: the last
+// step's result and the number of steps.
+static std::pair<StepResult, int> finish_episode(TransitionEnv& env, const Skill& b, std::vector<float>& obs) {
+  std::vector<float> act(env.spec().act_dim);
+  int steps = 0;
+  StepResult sr;
+  do {
+    b.policy.act(obs.data(), 1, act.data());
+    sr = env.step(act.data(), obs.data());
+    ++steps;
+  } while (!sr.done());
+  return {sr, steps};
+}
+
 TEST(TransitionEnv, EpisodesStartInSaAndEndWithTheInterval) {
   CompositeRecipe r = CompositeRecipe::load(CompositeRecipe::default_file("patrol"), {"env.push_prob=0"});
   const Transition& t = r.meta.transitions()[0];  // forward -> balance: since_turn in [0, 100]
@@ -138,7 +152,7 @@ TEST(TransitionEnv, EpisodesStartInSaAndEndWithTheInterval) {
   const Skill& b = r.skills[t.to];
   TransitionEnv env(r.make_env(), s, t, b.obs_begin, b.obs_end);
   EXPECT_EQ(env.spec().obs_dim, 26);
-  std::vector<float> obs(26), act(6);
+  std::vector<float> obs(26);
   std::vector<double> f(env.task().spec().feature_names.size());
   for (int episode = 0; episode < 3; ++episode) {
     env.reset(100 + episode, obs.data());
@@ -147,13 +161,7 @@ TEST(TransitionEnv, EpisodesStartInSaAndEndWithTheInterval) {
     for (int i = 0; i < s.size(); ++i)
       found |= std::equal(obs.begin(), obs.end(), s.obs.begin() + size_t(i) * s.obs_dim);
     EXPECT_TRUE(found);
-    int steps = 0;
-    StepResult sr;
-    do {
-      b.policy.act(obs.data(), 1, act.data());
-      sr = env.step(act.data(), obs.data());
-      ++steps;
-    } while (!sr.done());
+    auto [sr, steps] = finish_episode(env, b, obs);
     env.features(f.data());
     if (sr.truncated) EXPECT_FALSE(MetaController::holds(t.when, f.data()));  // left the interval
     EXPECT_LE(steps, 101);  // since_turn runs 0..100 from the start state
@@ -168,15 +176,9 @@ TEST(TransitionEnv, MaxStepsEndTheIntervalEarly) {
   const Skill& b = r.skills[t.to];
   auto run = [&](const Transition& tr, uint64_t seed) {
     TransitionEnv env(r.make_env(), s, tr, b.obs_begin, b.obs_end);
-    std::vector<float> obs(26), act(6);
+    std::vector<float> obs(26);
     env.reset(seed, obs.data());
-    int steps = 0;
-    StepResult sr;
-    do {
-      b.policy.act(obs.data(), 1, act.data());
-      sr = env.step(act.data(), obs.data());
-      ++steps;
-    } while (!sr.done());
+    auto [sr, steps] = finish_episode(env, b, obs);
     return std::make_tuple(steps, sr.truncated, sr.info.success);
   };
   t.max_steps = 30;

@@ -128,6 +128,12 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run("train " + es_alone + " --set 'es.inputs=[28, 26]'"), "key 'es.inputs': must be [begin, end)");
   auto curbs = write("curbs.yaml", "task: walker_jump\nenv: {curbs: 0}\n");
   expect_one_line_error(run("train " + curbs), "key 'env.curbs': must be at least 1");
+  // A composite recipe's transition and switch keys are checked when it is read.
+  const std::string patrol = "eval --task patrol --method tp --episodes 1 --recipe " + std::string(SEGUE_SOURCE_DIR) +
+                             "/experiments/patrol.yaml --set ";
+  expect_one_line_error(run(patrol + "switch.validation_starts=-1"), "key 'switch.validation_starts': must be >= 0");
+  expect_one_line_error(run(patrol + "'switch.margins=[]'"), "key 'switch.margins': lists no margin");
+  expect_one_line_error(run(patrol + "transitions.0.max_steps=0"), "key 'transitions.0.max_steps': must be positive");
 }
 
 TEST_F(CliErrors, BadPoliciesAndFlags) {
