@@ -68,7 +68,7 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
 }
 
 bool Transition::running(const double* features, int steps) const {
-  return (max_steps <= 0 || steps < max_steps) && MetaController::holds(when, features);
+  return !capped(steps) && MetaController::holds(when, features);
 }
 
 bool MetaController::holds(const std::vector<Condition>& when, const double* f) {

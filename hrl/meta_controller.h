@@ -48,6 +48,7 @@ struct Transition {
   // learn to stay in one for ever (its reward per step need not be negative); the cap
   // bounds how long the skill after it waits.
   int max_steps = 0;
+  bool capped(int steps) const { return max_steps > 0 && steps >= max_steps; }
   // Whether a transition policy that has taken `steps` steps in the interval keeps control.
   bool running(const double* features, int steps) const;
 };

@@ -36,7 +36,7 @@ StepResult TransitionEnv::step(const float* action, float* obs) {
   slice(obs);
   task_->features(features_.data());
   const bool left = !MetaController::holds(transition_.when, features_.data());
-  if (!r.terminated && !transition_.running(features_.data(), ++steps_)) r.truncated = true;
+  if (!r.terminated && (left || transition_.capped(++steps_))) r.truncated = true;  // Transition::running
   // A transition episode succeeds when it reaches the interval's end on its feet (not
   // when max_steps cut it short).
   r.info.success = left && !r.terminated;

@@ -264,6 +264,7 @@ TEST(MetaController, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
   EXPECT_EQ(filtered.transitions()[0].expert_when[0].lo, 2.0);
   EXPECT_EQ(filtered.transitions()[0].expert_when[0].hi, 3.0);
   EXPECT_TRUE(filtered.transitions()[0].expert_successful);
+  EXPECT_FALSE(meta.transitions()[0].expert_successful);
   EXPECT_EQ(meta.transitions()[0].max_steps, 0);  // no cap unless asked
   Recipe capped = Recipe::parse(head + "max_steps: 300}", "r.yaml");
   EXPECT_EQ(MetaController(capped.root(), skills, {"ceiling_ahead"}).transitions()[0].max_steps, 300);
@@ -274,7 +275,6 @@ TEST(MetaController, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
   } catch (const Error& e) {
     EXPECT_EQ(std::string(e.what()), "r.yaml: key 'transitions.0.max_steps': must be positive");
   }
-  EXPECT_FALSE(meta.transitions()[0].expert_successful);
   refused("{task: walker_crawl}", "r.yaml: missing required key 'transitions.0.expert.steps'");
   refused("{task: walker_crawl, steps: 0}", "r.yaml: key 'transitions.0.expert.steps': must be positive");
   refused("{task: walker_crawl, steps: 9, when: {ceiling_ahead: [0, 1]}}",

@@ -192,9 +192,9 @@ TEST_F(TransitionTraining, SwitchMarginIsChosenOnHeldOutStarts) {
   TransitionController after(r.skills, r.meta, {}, SwitchRule::IntervalEnd);
   std::vector<float> obs(r.spec.obs_dim), act(r.spec.act_dim), q(2);
   std::vector<double> f(r.spec.feature_names.size()), state;
+  const Policy plain = trainer.q_function();
   for (size_t m = 0; m < c.margins.size(); ++m) {
     Policy q_ab = trainer.q_function(c.margins[m]);
-    Policy plain = trainer.q_function();
     std::vector<float> q0(2);
     q_ab.act(obs.data(), 1, q.data());
     plain.act(obs.data(), 1, q0.data());
