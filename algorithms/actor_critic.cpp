@@ -5,8 +5,8 @@
 namespace segue {
 
 ActorCriticImpl::ActorCriticImpl(const ActorCriticSpec& s) : spec(s) {
-  actor = register_module("actor", make_mlp(s.obs_dim, s.pi_hidden, s.act_dim, s.activation, 0.01));
-  critic = register_module("critic", make_mlp(s.obs_dim, s.vf_hidden, 1, s.activation, 1.0));
+  actor = register_module("actor", make_mlp(s.in_dim(), s.pi_hidden, s.act_dim, s.activation, 0.01));
+  critic = register_module("critic", make_mlp(s.in_dim(), s.vf_hidden, 1, s.activation, 1.0));
   log_std = register_parameter("log_std", torch::full({s.act_dim}, s.init_log_std));
 }
 

@@ -5,6 +5,7 @@
 #include <torch/torch.h>
 
 #include "algorithms/mlp.h"
+#include "algorithms/obs_features.h"
 
 namespace segue {
 
@@ -17,6 +18,9 @@ struct ActorCriticSpec {
   // [begin, end) of the observation that neither network sees (the normaliser maps it to
   // 0); empty = none. E.g. the walker's qacc, [17, 26] (walker_jump_noqacc.yaml).
   std::vector<int> ignore_obs;
+  // Periodic features of raw inputs, appended after the normalised observation (both nets).
+  ObsFeatures features;
+  int in_dim() const { return obs_dim + features.size(); }
 };
 
 class ActorCriticImpl : public torch::nn::Module {

@@ -56,9 +56,9 @@ SearchedParameters::SearchedParameters(Policy start, const std::vector<int>& inp
     index_.resize(full_.size());
     std::iota(index_.begin(), index_.end(), size_t(0));
   } else {
-    if (inputs.size() != 2 || inputs[0] < 0 || inputs[0] >= inputs[1] || inputs[1] > start_.obs_dim())
-      throw Error("inputs must be [begin, end) within the policy's " + std::to_string(start_.obs_dim()) +
-                  " observation inputs");
+    if (inputs.size() != 2 || inputs[0] < 0 || inputs[0] >= inputs[1] || inputs[1] > start_.in_dim())
+      throw Error("inputs must be [begin, end) within the policy's " + std::to_string(start_.in_dim()) +
+                  " network inputs (observation, then any periodic features)");
     index_ = start_.mlp().input_weight_indices(inputs[0], inputs[1]);
   }
 }

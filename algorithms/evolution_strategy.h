@@ -29,7 +29,7 @@ struct EsConfig {
   int episodes = 16;    // per candidate, on the generation's common seeds
   double sigma = 0.02;  // perturbation scale, in parameter units
   double lr = 0.01;     // Adam step size
-  // Search only the first layer's weights from these observation inputs [begin, end),
+  // Search only the first layer's weights from these network inputs [begin, end),
   // e.g. the jump's obstacle pair: the gait stays, and how it depends on the curb's
   // distance is what moves. Empty: every parameter.
   std::vector<int> inputs;
@@ -46,10 +46,11 @@ struct EsConfig {
 std::vector<double> centred_ranks(const std::vector<double>& fitness);
 
 // The parameters a run searches: all of a policy's network, or only the first layer's
-// weights from observation inputs [inputs[0], inputs[1]); the rest stay as trained.
+// weights from network inputs [inputs[0], inputs[1]); the rest stay as trained.
 class SearchedParameters {
  public:
-  // Throws segue::Error when `inputs` lies outside the policy's observation.
+  // Throws segue::Error when `inputs` lies outside the network's inputs (the
+  // observation, then any periodic features).
   SearchedParameters(Policy start, const std::vector<int>& inputs);
   std::vector<float> initial() const;                // the start policy's values
   Policy policy_at(const std::vector<float>& theta) const;

@@ -14,21 +14,28 @@
 namespace segue {
 
 Policy::Policy(EigenMlp mlp, std::vector<float> mean, std::vector<float> inv_std, float clip,
-               std::vector<float> low, std::vector<float> high)
+               std::vector<float> low, std::vector<float> high, ObsFeatures features)
     : mlp_(std::move(mlp)), obs_mean_(std::move(mean)), obs_inv_std_(std::move(inv_std)),
-      act_low_(std::move(low)), act_high_(std::move(high)), obs_clip_(clip) {}
+      act_low_(std::move(low)), act_high_(std::move(high)), obs_clip_(clip),
+      features_(std::move(features)) {
+  if (mlp_.in_dim() != in_dim())
+    throw Error("policy: the network takes " + std::to_string(mlp_.in_dim()) +
+                " inputs, the normaliser and features give " + std::to_string(in_dim()));
+}
 
 void Policy::normalize(const float* obs, int batch, float* out) const {
-  const int d = obs_dim();
-  for (int b = 0; b < batch; ++b)
-    for (int j = 0; j < d; ++j)
-      out[size_t(b) * d + j] =
-          std::clamp((obs[size_t(b) * d + j] - obs_mean_[j]) * obs_inv_std_[j], -obs_clip_, obs_clip_);
+  const int d = obs_dim(), n = in_dim();
+  for (int b = 0; b < batch; ++b) {
+    const float* s = obs + size_t(b) * d;
+    float* x = out + size_t(b) * n;
+    for (int j = 0; j < d; ++j) x[j] = std::clamp((s[j] - obs_mean_[j]) * obs_inv_std_[j], -obs_clip_, obs_clip_);
+    features_.write(s, x + d);
+  }
 }
 
 void Policy::act(const float* obs, int batch, float* actions) const {
   const int k = act_dim();
-  normalized_.resize(size_t(batch) * obs_dim());
+  normalized_.resize(size_t(batch) * in_dim());
   normalize(obs, batch, normalized_.data());
   mlp_.forward(normalized_.data(), batch, actions);
   for (int b = 0; b < batch; ++b)
@@ -81,6 +88,16 @@ void Policy::export_torchscript(const std::string& path) const {
       << "def act_dim(self) -> int:\n    return self.n_act\n"
       << "def forward(self, obs: Tensor) -> Tensor:\n"
       << "    x = torch.clamp((obs - self.obs_mean) * self.obs_inv_std, -self.obs_clip, self.obs_clip)\n";
+  // Periodic features in ObsFeatures::write's order: per input, per period, sin then cos.
+  if (!features_.empty()) {
+    std::vector<int64_t> inputs(features_.inputs.begin(), features_.inputs.end());
+    m.register_buffer("feature_inputs", torch::tensor(inputs, torch::kLong));
+    m.register_buffer("feature_periods", torch::tensor(features_.periods, torch::kFloat64));
+    src << "    phase = 2.0 * 3.141592653589793 * obs.double().index_select(1, self.feature_inputs).unsqueeze(2)"
+        << " / self.feature_periods\n"
+        << "    f = torch.stack([torch.sin(phase), torch.cos(phase)], 3).reshape(obs.size(0), -1).float()\n"
+        << "    x = torch.cat([x, f], 1)\n";
+  }
   for (size_t i = 0; i < layers; ++i) {
     m.register_buffer("w" + std::to_string(i), mat(mlp_.weights()[i]));
     m.register_buffer("b" + std::to_string(i), mat(mlp_.biases()[i]).reshape({-1}));
@@ -102,10 +119,17 @@ Policy Policy::load_torchscript(const std::string& path) {
     bs.push_back(m.attr("b" + std::to_string(i)).toTensor());
   }
   if (ws.empty()) throw Error(path + ": not a Segue policy (no layers w0, b0, ...)");
+  ObsFeatures features;
+  if (m.hasattr("feature_inputs")) {
+    auto in = m.attr("feature_inputs").toTensor().to(torch::kLong).contiguous();
+    auto per = m.attr("feature_periods").toTensor().to(torch::kFloat64).contiguous();
+    features.inputs.assign(in.data_ptr<int64_t>(), in.data_ptr<int64_t>() + in.numel());
+    features.periods.assign(per.data_ptr<double>(), per.data_ptr<double>() + per.numel());
+  }
   Policy p(EigenMlp(ws, bs, parse_activation(m.attr("activation").toStringRef())),
            to_vec(m.attr("obs_mean").toTensor()), to_vec(m.attr("obs_inv_std").toTensor()),
            float(m.attr("obs_clip").toDouble()), to_vec(m.attr("act_low").toTensor()),
-           to_vec(m.attr("act_high").toTensor()));
+           to_vec(m.attr("act_high").toTensor()), features);
   // The Eigen forward must be the function the file defines: check on a random batch.
   torch::manual_seed(0);
   auto obs = torch::randn({8, p.obs_dim()}) * 3.0;

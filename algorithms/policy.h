@@ -1,12 +1,14 @@
 #pragma once
 // A trained policy as a plain function of the observation, for evaluation and for
-// composing skills: a = clamp(mu(clip((s - mean) * inv_std)), low, high). The same
+// composing skills: a = clamp(mu([clip((s - mean) * inv_std), features(s)]), low, high)
+// (features: ObsFeatures, usually none). The same
 // function is exported as TorchScript (runnable with torch.jit.load in Python) and read
 // back from it; inference runs the Eigen mirror of the network.
 #include <string>
 #include <vector>
 
 #include "algorithms/mlp.h"
+#include "algorithms/obs_features.h"
 #include "core/env.h"
 
 namespace segue {
@@ -15,9 +17,11 @@ class Policy {
  public:
   Policy() = default;
   Policy(EigenMlp mlp, std::vector<float> obs_mean, std::vector<float> obs_inv_std, float obs_clip,
-         std::vector<float> act_low, std::vector<float> act_high);
+         std::vector<float> act_low, std::vector<float> act_high, ObsFeatures features = {});
 
-  int obs_dim() const { return mlp_.in_dim(); }
+  int obs_dim() const { return static_cast<int>(obs_mean_.size()); }
+  int in_dim() const { return obs_dim() + features_.size(); }  // the network's input
+  const ObsFeatures& features() const { return features_; }
   int act_dim() const { return mlp_.out_dim(); }
   const EigenMlp& mlp() const { return mlp_; }
   const std::vector<float>& obs_mean() const { return obs_mean_; }
@@ -25,7 +29,8 @@ class Policy {
   // The same policy (normaliser, action bounds) with other network parameters, laid out
   // as EigenMlp::parameters().
   Policy with_parameters(const std::vector<float>& theta) const;
-  // The network's input: clip((s - mean) * inv_std), [batch, obs_dim] -> [batch, obs_dim].
+  // The network's input: [clip((s - mean) * inv_std), features(s)], [batch, obs_dim] ->
+  // [batch, in_dim].
   void normalize(const float* obs, int batch, float* out) const;
   // obs: [batch, obs_dim] -> actions: [batch, act_dim]. Allocates only when the batch grows.
   void act(const float* obs, int batch, float* actions) const;
@@ -44,6 +49,7 @@ class Policy {
   EigenMlp mlp_;
   std::vector<float> obs_mean_, obs_inv_std_, act_low_, act_high_;
   float obs_clip_ = 10.0f;
+  ObsFeatures features_;
   mutable std::vector<float> normalized_;
 };
 

@@ -50,7 +50,7 @@ PPO::PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, u
   if (!net.ignore_obs.empty()) obs_rms_.ignore(net.ignore_obs.at(0), net.ignore_obs.at(1));
   optimizer_ = std::make_unique<torch::optim::Adam>(net_->parameters(),
                                                      torch::optim::AdamOptions(cfg_.lr).eps(1e-5));
-  buf_.resize(cfg_.steps_per_env, envs.size(), net.obs_dim, net.act_dim);
+  buf_.resize(cfg_.steps_per_env, envs.size(), net.obs_dim, net.act_dim, net.in_dim());
   running_return_.assign(envs.size(), 0.0);
   mean_.resize(size_t(envs.size()) * net.act_dim);
   noise_.resize(size_t(envs.size()) * net.act_dim);
@@ -71,6 +71,11 @@ void PPO::set_log_std(double log_std) {
   torch::NoGradGuard no_grad;
   net_->log_std.fill_(log_std);
   refresh_inference_copy();
+}
+
+void PPO::net_input(const float* raw, float* out) const {
+  obs_rms_.normalize(raw, out);
+  net_->spec.features.write(raw, out + buf_.obs_dim);
 }
 
 void PPO::refresh_inference_copy() {
@@ -116,7 +121,7 @@ void PPO::sample_actions(int t) {
 }
 
 void PPO::collect_rollout(IterationStats& stats) {
-  const int T = buf_.T, N = buf_.N, D = buf_.obs_dim;
+  const int T = buf_.T, N = buf_.N, D = buf_.obs_dim, I = buf_.in_dim;
   buf_.truncated_index.clear();
   buf_.truncated_obs.clear();
   envs_.finished().clear();
@@ -124,7 +129,7 @@ void PPO::collect_rollout(IterationStats& stats) {
   for (int t = 0; t < T; ++t) {
     std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf_.raw_obs_at(t));
     for (int i = 0; i < N; ++i)
-      obs_rms_.normalize(buf_.raw_obs_at(t) + size_t(i) * D, buf_.obs_at(t) + size_t(i) * D);
+      net_input(buf_.raw_obs_at(t) + size_t(i) * D, buf_.obs_at(t) + size_t(i) * I);
     sample_actions(t);
     envs_.step(buf_.actions_at(t));
     std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf_.next_raw_obs_at(t));
@@ -138,8 +143,8 @@ void PPO::collect_rollout(IterationStats& stats) {
       if (buf_.dones[k]) noise_age_[i] = 0;
       if (envs_.truncated()[i] && !envs_.terminated()[i]) {
         buf_.truncated_index.push_back(static_cast<int>(k));
-        buf_.truncated_obs.resize(buf_.truncated_obs.size() + D);
-        obs_rms_.normalize(envs_.final_obs() + size_t(i) * D, &buf_.truncated_obs[buf_.truncated_obs.size() - D]);
+        buf_.truncated_obs.resize(buf_.truncated_obs.size() + I);
+        net_input(envs_.final_obs() + size_t(i) * D, &buf_.truncated_obs[buf_.truncated_obs.size() - I]);
       }
     }
   }
@@ -175,16 +180,16 @@ void PPO::collect_rollout(IterationStats& stats) {
     if (!std::isfinite(r)) throw Error("task '" + envs_.spec().name + "' produced a non-finite reward");
 
   torch::NoGradGuard no_grad;
-  auto values = net_->value(torch::from_blob(buf_.obs.data(), {int64_t(T) * N, D}));
+  auto values = net_->value(torch::from_blob(buf_.obs.data(), {int64_t(T) * N, I}));
   std::copy(values.data_ptr<float>(), values.data_ptr<float>() + values.numel(), buf_.values.begin());
-  std::vector<float> last_obs(size_t(N) * D), last_values(N);
-  for (int i = 0; i < N; ++i) obs_rms_.normalize(envs_.obs() + size_t(i) * D, &last_obs[size_t(i) * D]);
-  auto lv = net_->value(torch::from_blob(last_obs.data(), {N, D}));
+  std::vector<float> last_obs(size_t(N) * I), last_values(N);
+  for (int i = 0; i < N; ++i) net_input(envs_.obs() + size_t(i) * D, &last_obs[size_t(i) * I]);
+  auto lv = net_->value(torch::from_blob(last_obs.data(), {N, I}));
   std::copy(lv.data_ptr<float>(), lv.data_ptr<float>() + N, last_values.begin());
   // A time limit is not a real end: fold gamma V(final state) into the last reward.
   if (!buf_.truncated_index.empty()) {
     int64_t n = static_cast<int64_t>(buf_.truncated_index.size());
-    auto tv = net_->value(torch::from_blob(buf_.truncated_obs.data(), {n, D}));
+    auto tv = net_->value(torch::from_blob(buf_.truncated_obs.data(), {n, I}));
     for (int64_t j = 0; j < n; ++j)
       buf_.rewards[buf_.truncated_index[j]] += static_cast<float>(cfg_.gamma * tv[j].item<float>());
   }
@@ -203,7 +208,7 @@ void PPO::update(IterationStats& stats) {
     for (auto& group : optimizer_->param_groups())
       static_cast<torch::optim::AdamOptions&>(group.options()).lr(cfg_.lr * std::max(frac, 0.0));
   }
-  auto obs = torch::from_blob(buf_.obs.data(), {M, buf_.obs_dim});
+  auto obs = torch::from_blob(buf_.obs.data(), {M, buf_.in_dim});
   auto act = torch::from_blob(buf_.actions.data(), {M, buf_.act_dim});
   auto old_logp = torch::from_blob(buf_.log_probs.data(), {M});
   auto adv = torch::from_blob(buf_.advantages.data(), {M});
@@ -253,9 +258,9 @@ void PPO::update(IterationStats& stats) {
 }
 
 torch::Tensor PPO::log_prob(const float* raw_obs, const float* actions, int64_t n) {
-  const int D = buf_.obs_dim;
-  auto obs = torch::empty({n, D});
-  for (int64_t i = 0; i < n; ++i) obs_rms_.normalize(raw_obs + i * D, obs.data_ptr<float>() + i * D);
+  const int D = buf_.obs_dim, I = buf_.in_dim;
+  auto obs = torch::empty({n, I});
+  for (int64_t i = 0; i < n; ++i) net_input(raw_obs + i * D, obs.data_ptr<float>() + i * I);
   torch::NoGradGuard no_grad;
   auto act = torch::from_blob(const_cast<float*>(actions), {n, int64_t(buf_.act_dim)});
   return net_->log_prob(net_->mean(obs), act);
@@ -264,6 +269,10 @@ torch::Tensor PPO::log_prob(const float* raw_obs, const float* actions, int64_t 
 void PPO::init_actor(const Policy& p, float extra_bias) {
   if (p.obs_dim() > buf_.obs_dim || p.act_dim() > buf_.act_dim)
     throw Error("init_actor: the policy's sizes differ from the trainer's");
+  // A policy without features starts a trainer with them at zero weight on the features;
+  // one with features must have the trainer's (its columns are then the same).
+  if (!p.features().empty() && (!(p.features() == net_->spec.features) || p.obs_dim() != buf_.obs_dim))
+    throw Error("init_actor: the policy's periodic input features differ from the trainer's");
   const auto& ws = p.mlp().weights();
   const auto& bs = p.mlp().biases();
   torch::NoGradGuard no_grad;
@@ -303,7 +312,8 @@ void PPO::init_actor(const Policy& p, float extra_bias) {
 Policy PPO::policy() const {
   const auto& spec = envs_.spec();
   return Policy(actor_copy_, std::vector<float>(obs_rms_.mean().begin(), obs_rms_.mean().end()),
-                obs_rms_.inv_std(), static_cast<float>(obs_rms_.clip()), spec.act_low, spec.act_high);
+                obs_rms_.inv_std(), static_cast<float>(obs_rms_.clip()), spec.act_low, spec.act_high,
+                net_->spec.features);
 }
 
 // ---- checkpoints -------------------------------------------------------------------
@@ -322,6 +332,22 @@ std::vector<int> to_ints(const torch::Tensor& t) {
   return v;
 }
 std::vector<int64_t> widen(const std::vector<int>& v) { return {v.begin(), v.end()}; }
+// The periodic features, if any (older checkpoints have none).
+void write_features(torch::serialize::OutputArchive& ar, const ObsFeatures& f) {
+  if (f.empty()) return;
+  ar.write("meta_feature_inputs", ints(widen(f.inputs)));
+  ar.write("meta_feature_periods", torch::tensor(f.periods, torch::kFloat64));
+}
+ObsFeatures read_features(torch::serialize::InputArchive& ar) {
+  ObsFeatures f;
+  torch::Tensor in, per;
+  if (!ar.try_read("meta_feature_inputs", in)) return f;
+  ar.read("meta_feature_periods", per);
+  f.inputs = to_ints(in);
+  per = per.contiguous();
+  f.periods.assign(per.data_ptr<double>(), per.data_ptr<double>() + per.numel());
+  return f;
+}
 
 }  // namespace
 
@@ -339,6 +365,7 @@ void PPO::save(const std::string& path, const std::string& note, const ArchiveWr
   ar.write("meta_dims", ints({s.obs_dim, s.act_dim, s.activation == Activation::Tanh ? 0 : 1}));
   ar.write("meta_pi_hidden", ints(widen(s.pi_hidden)));
   ar.write("meta_vf_hidden", ints(widen(s.vf_hidden)));
+  write_features(ar, s.features);
   ar.write("meta_act_low", torch::tensor(envs_.spec().act_low));
   ar.write("meta_act_high", torch::tensor(envs_.spec().act_high));
   ar.write("meta_note", torch::tensor(std::vector<int64_t>(note.begin(), note.end()), torch::kLong));
@@ -355,6 +382,8 @@ void PPO::load(const std::string& path, const ArchiveReader& extra) {
   ar.read("meta_dims", dims);
   if (dims[0].item<int64_t>() != net_->spec.obs_dim || dims[1].item<int64_t>() != net_->spec.act_dim)
     throw Error(path + ": checkpoint sizes do not match the task");
+  if (!(read_features(ar) == net_->spec.features))
+    throw Error(path + ": checkpoint's policy.fourier features differ from the recipe's");
   torch::NoGradGuard no_grad;
   for (auto& p : net_->named_parameters()) {
     torch::Tensor t;
@@ -395,6 +424,7 @@ Policy PPO::policy_from_checkpoint(const std::string& path) {
   spec.activation = dims[2].item<int64_t>() == 0 ? Activation::Tanh : Activation::Relu;
   spec.pi_hidden = to_ints(pi);
   spec.vf_hidden = to_ints(vf);
+  spec.features = read_features(ar);
   ActorCritic net(spec);
   torch::NoGradGuard no_grad;
   for (auto& p : net->named_parameters()) {
@@ -410,7 +440,7 @@ Policy PPO::policy_from_checkpoint(const std::string& path) {
   };
   return Policy(EigenMlp(net->actor, spec.activation),
                 std::vector<float>(rms.mean().begin(), rms.mean().end()), rms.inv_std(),
-                static_cast<float>(rms.clip()), to_vec(low), to_vec(high));
+                static_cast<float>(rms.clip()), to_vec(low), to_vec(high), spec.features);
 }
 
 }  // namespace segue

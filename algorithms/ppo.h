@@ -116,6 +116,8 @@ class PPO {
  private:
   void sample_actions(int t);
   void refresh_inference_copy();
+  // The networks' input for one raw observation: normalised, then the periodic features.
+  void net_input(const float* raw, float* out) const;
 
   PpoConfig cfg_;
   VectorEnv& envs_;

@@ -12,7 +12,10 @@
 //   init_policy: assets/policies/walker/walker_forward.pt  # optional: start the actor as a skill
 //   env: {...}                # the task's settings (reference defaults)
 //   policy: {pi_hidden: [32, 32], vf_hidden: [32, 32], activation: tanh, init_log_std: -0.5,
-//            ignore_obs: [17, 26]}   # optional: inputs neither net sees (here the qacc)
+//            ignore_obs: [17, 26],   # optional: inputs neither net sees (here the qacc)
+//            fourier: {inputs: [26], periods: [0.95, 1.9, 3.8]}}  # optional: sin and cos
+//                                    # of 2 pi x_i / P appended to both nets' input
+//                                    # (ObsFeatures; here the curb's distance)
 //   ppo: {...}                # see PpoConfig
 //   eval: {episodes: 50, seed: 1000, reference_task: false}
 //   es: {...}                 # instead of ppo: fine-tune init_policy with evolution

@@ -8,7 +8,8 @@ namespace segue {
 
 struct RolloutBuffer {
   int T = 0, N = 0, obs_dim = 0, act_dim = 0;
-  std::vector<float> obs;       // normalised observations the policy saw  [T, N, obs_dim]
+  int in_dim = 0;               // the networks' input: obs_dim, plus any appended features
+  std::vector<float> obs;       // the networks' inputs (normalised observations)  [T, N, in_dim]
   std::vector<float> raw_obs;   // the same before normalisation (for the normaliser)
   std::vector<float> next_raw_obs;  // s' before normalisation (the final one where an episode ended)
   std::vector<float> actions;   // sampled, unclipped                       [T, N, act_dim]
@@ -17,14 +18,14 @@ struct RolloutBuffer {
   std::vector<float> rewards;   // scaled, with truncation bootstraps folded in  [T, N]
   std::vector<uint8_t> dones;   // episode ended at this step              [T, N]
   std::vector<float> values, advantages, returns;  // [T, N]
-  // Truncated steps: their index t*N+n and the (normalised) final observation to bootstrap.
+  // Truncated steps: their index t*N+n and the final observation as network input [in_dim].
   std::vector<int> truncated_index;
   std::vector<float> truncated_obs;
 
-  void resize(int t, int n, int od, int ad) {
-    T = t, N = n, obs_dim = od, act_dim = ad;
+  void resize(int t, int n, int od, int ad, int id) {
+    T = t, N = n, obs_dim = od, act_dim = ad, in_dim = id;
     size_t steps = size_t(t) * n;
-    obs.resize(steps * od);
+    obs.resize(steps * id);
     raw_obs.resize(steps * od);
     next_raw_obs.resize(steps * od);
     actions.resize(steps * ad);
@@ -36,9 +37,9 @@ struct RolloutBuffer {
     advantages.resize(steps);
     returns.resize(steps);
     truncated_index.reserve(steps);
-    truncated_obs.reserve(steps * od);
+    truncated_obs.reserve(steps * id);
   }
-  float* obs_at(int t) { return &obs[size_t(t) * N * obs_dim]; }
+  float* obs_at(int t) { return &obs[size_t(t) * N * in_dim]; }
   float* raw_obs_at(int t) { return &raw_obs[size_t(t) * N * obs_dim]; }
   float* next_raw_obs_at(int t) { return &next_raw_obs[size_t(t) * N * obs_dim]; }
   float* actions_at(int t) { return &actions[size_t(t) * N * act_dim]; }

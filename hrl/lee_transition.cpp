@@ -64,13 +64,7 @@ StepResult LeeTransitionEnv::step(const float* action, float* obs) {
 LeeTrainer::LeeTrainer(const TransitionPolicyConfig& tp, const LeeConfig& c, VectorEnv& envs,
                        const Demonstrations& expert, const Policy& next, uint64_t seed)
     : cfg_(c), envs_(envs),
-      ppo_(tp.ppo,
-           [&] {
-             ActorCriticSpec n = tp.net;
-             n.obs_dim = envs.spec().obs_dim, n.act_dim = envs.spec().act_dim;
-             return n;
-           }(),
-           envs, seed),
+      ppo_(tp.ppo, tp.network(envs.spec(), next), envs, seed),
       obs_dim_(envs.spec().obs_dim) {
   if (expert.obs_dim != obs_dim_) throw Error("Lee transition policy: T_b's observation size differs from pi_b's");
   if (tp.init_from_next) ppo_.init_actor(next, c.termination_bias);

@@ -37,7 +37,7 @@ struct Transition {
   int expert_steps = 0;
   // Keep only the windows after which pi_b goes on to succeed (`expert: {successful: true}`):
   // the states pi_b expects are those it succeeds from. Matters when pi_b itself often
-  // fails (a 38% jump): matching all of its states would match its failures too.
+  // fails (stage 13's jump cleared 38%): matching all its states would match its failures too.
   bool expert_successful = false;
   // |S_a| for this transition (`start_states: N`); 0 takes collect.start_states. A late
   // interval is reached only as often as every earlier hand-over succeeds, so a recipe

@@ -39,6 +39,14 @@ TransitionPolicyConfig TransitionPolicyConfig::read(const Section& s) {
   return c;
 }
 
+ActorCriticSpec TransitionPolicyConfig::network(const EnvSpec& env, const Policy& next) const {
+  ActorCriticSpec n = net;
+  n.obs_dim = env.obs_dim;
+  n.act_dim = env.act_dim;
+  if (init_from_next) n.features = next.features();
+  return n;
+}
+
 SwitchConfig SwitchConfig::read(const Section& s) {
   SwitchConfig c;
   c.net.hidden = s.get("hidden", c.net.hidden);

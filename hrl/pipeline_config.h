@@ -46,6 +46,9 @@ struct TransitionPolicyConfig {
 
   // Reads the recipe's `transition:` section (every key has a default).
   static TransitionPolicyConfig read(const Section& s);
+  // pi_ab's network on its environment: sized to it and, when pi_ab starts as pi_b
+  // (init_from_next), with pi_b's periodic input features, so it can start as exactly pi_b.
+  ActorCriticSpec network(const EnvSpec& env, const Policy& next) const;
 };
 
 struct SwitchConfig {

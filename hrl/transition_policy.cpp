@@ -6,11 +6,6 @@ namespace segue {
 
 namespace {
 
-ActorCriticSpec sized(ActorCriticSpec net, const EnvSpec& spec) {
-  net.obs_dim = spec.obs_dim;
-  net.act_dim = spec.act_dim;
-  return net;
-}
 torch::Tensor rows(const std::vector<float>& v, int64_t n) {
   return torch::from_blob(const_cast<float*>(v.data()), {n, int64_t(v.size()) / std::max<int64_t>(n, 1)}).clone();
 }
@@ -19,7 +14,7 @@ torch::Tensor rows(const std::vector<float>& v, int64_t n) {
 
 TransitionPolicyTrainer::TransitionPolicyTrainer(const TransitionPolicyConfig& config, VectorEnv& envs,
                                                  Demonstrations expert, const Policy& next, uint64_t seed)
-    : cfg_(config), ppo_(config.ppo, sized(config.net, envs.spec()), envs, seed), expert_(std::move(expert)),
+    : cfg_(config), ppo_(config.ppo, config.network(envs.spec(), next), envs, seed), expert_(std::move(expert)),
       act_low_(envs.spec().act_low), act_high_(envs.spec().act_high) {
   const EnvSpec& spec = envs.spec();
   if (expert_.obs_dim != spec.obs_dim || expert_.act_dim != spec.act_dim)

@@ -257,7 +257,7 @@ TEST_F(CollectionFiles, SuccessfulDemonstrationsAreTheWindowsPiBSucceedsFrom) {
     else if (entered) ++dropped;
   }
   EXPECT_GT(kept, 0);
-  EXPECT_GT(dropped, 0);  // the 38% jump fails from some windows: they are not in T_b
+  EXPECT_GT(dropped, 0);  // the jump fails from some windows: they are not in T_b
   EXPECT_EQ(d.obs, want);
 }
 

@@ -36,7 +36,7 @@ class PolicyFiles : public TempDirTest {
   PolicyFiles() : TempDirTest("policy") {}
   // One short PPO iteration on walk forward (a non-trivial normaliser and weights), saved
   // as p.pt (TorchScript) and ckpt.pt; returns the in-memory policy.
-  Policy train_and_save(const std::vector<int>& ignore_obs = {}) {
+  Policy train_and_save(const std::vector<int>& ignore_obs = {}, const ObsFeatures& features = {}) {
     Recipe r = Recipe::parse("{}", "test");
     VectorEnv envs(task_factory("walker_forward", r.root().sub("env")), 4, 1);
     PpoConfig cfg;
@@ -48,6 +48,7 @@ class PolicyFiles : public TempDirTest {
     spec.obs_dim = 26;
     spec.act_dim = 6;
     spec.ignore_obs = ignore_obs;
+    spec.features = features;
     PPO ppo(cfg, spec, envs, 11);
     ppo.iterate();
     Policy mem = ppo.policy();
@@ -123,6 +124,81 @@ TEST_F(PolicyFiles, RefusesMismatchedAndMissingPolicies) {
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("obs_dim 5"), std::string::npos) << e.what();
   }
+}
+
+TEST(ObsFeatures, SinesAndCosinesOfTheChosenInputs) {
+  ObsFeatures f{{1, 3}, {2.0, 0.5}};
+  ASSERT_EQ(f.size(), 8);
+  const float raw[4] = {9.0f, 0.25f, 9.0f, -1.0f};
+  float out[8];
+  f.write(raw, out);
+  // x1 = 0.25: phase pi/4 at P = 2, pi at P = 0.5; x3 = -1: phase -pi, then -4 pi.
+  const float want[8] = {0.70710678f, 0.70710678f, 0.0f, -1.0f, 0.0f, -1.0f, 0.0f, 1.0f};
+  for (int k = 0; k < 8; ++k) EXPECT_NEAR(out[k], want[k], 1e-6f) << k;
+}
+
+// policy.fourier: the trained policy, its TorchScript and its checkpoint compute the same
+// features in the same order, and a checkpoint records them.
+TEST_F(PolicyFiles, PeriodicFeaturesSurviveEveryExport) {
+  const ObsFeatures f{{0, 5}, {0.3, 1.7}};
+  Policy mem = train_and_save({}, f);
+  EXPECT_EQ(mem.obs_dim(), 26);
+  EXPECT_EQ(mem.in_dim(), 34);
+  torch::jit::Module m = torch::jit::load(path("p.pt"));
+  EXPECT_EQ(m.run_method("obs_dim").toInt(), 26);
+  torch::manual_seed(4);
+  auto obs = torch::randn({7, 26}) * 2;
+  auto ts = m.forward({obs}).toTensor();
+  std::vector<float> a(7 * 6);
+  mem.act(obs.data_ptr<float>(), 7, a.data());
+  EXPECT_LT((ts - torch::from_blob(a.data(), {7, 6})).abs().max().item<float>(), 1e-5f);
+  for (const char* file : {"p.pt", "ckpt.pt"}) {
+    Policy loaded = Policy::load(path(file));
+    EXPECT_TRUE(loaded.features() == f) << file;
+    std::vector<float> b(7 * 6);
+    loaded.act(obs.data_ptr<float>(), 7, b.data());
+    for (int i = 0; i < 7 * 6; ++i) EXPECT_NEAR(a[i], b[i], 1e-6f) << file;
+  }
+  // The features are inputs the network uses: moving only input 5 by a quarter of 1.7 m
+  // (normalised input 5 pinned by a huge std) changes the action.
+  std::vector<float> x(26, 0.0f), y(26, 0.0f), ax(6), ay(6);
+  y[5] = 1.7f / 4;
+  std::vector<float> inv_std = mem.obs_inv_std();
+  inv_std[5] = 0.0f;
+  Policy pinned(mem.mlp(), mem.obs_mean(), inv_std, 10.0f, std::vector<float>(6, -1e9f), std::vector<float>(6, 1e9f), f);
+  pinned.act(x.data(), 1, ax.data());
+  pinned.act(y.data(), 1, ay.data());
+  EXPECT_NE(ax, ay);
+}
+
+// A featureless skill starts a trainer with features as exactly itself (the features'
+// weights start at zero), the way a jump with curb-phase inputs starts as the shipped jump.
+TEST_F(PolicyFiles, FeaturelessPolicyStartsATrainerWithFeatures) {
+  Policy plain = train_and_save();
+  Recipe r = Recipe::parse("{}", "test");
+  VectorEnv envs(task_factory("walker_forward", r.root().sub("env")), 2, 1);
+  PpoConfig cfg;
+  cfg.num_envs = 2;
+  ActorCriticSpec spec;
+  spec.obs_dim = 26;
+  spec.act_dim = 6;
+  spec.features = ObsFeatures{{3}, {1.0}};
+  PPO ppo(cfg, spec, envs, 5);
+  ppo.init_actor(plain);
+  Policy started = ppo.policy();
+  ASSERT_EQ(started.in_dim(), 28);
+  torch::manual_seed(6);
+  auto obs = torch::randn({5, 26});
+  std::vector<float> a(30), b(30);
+  plain.act(obs.data_ptr<float>(), 5, a.data());
+  started.act(obs.data_ptr<float>(), 5, b.data());
+  for (int i = 0; i < 30; ++i) EXPECT_NEAR(a[i], b[i], 1e-6f);
+  // A checkpoint with other features is refused by a trainer built from the recipe.
+  ppo.save(path("feat.pt"));
+  ActorCriticSpec other = spec;
+  other.features.periods = {2.0};
+  PPO mismatched(cfg, other, envs, 5);
+  EXPECT_THROW(mismatched.load(path("feat.pt")), Error);
 }
 
 }  // namespace segue

@@ -119,6 +119,10 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run("train " + wider), "key 'init_policy': 'assets/policies/walker/walker_jump.pt': policy takes obs_dim 28");
   auto ignore = write("ignore.yaml", "task: walker_forward\npolicy: {ignore_obs: [17, 30]}\n");
   expect_one_line_error(run("train " + ignore), "key 'policy.ignore_obs': must be [begin, end) with 0 <= begin < end <= 26");
+  auto fourier = write("fourier.yaml", "task: walker_jump\npolicy: {fourier: {inputs: [28], periods: [1.9]}}\n");
+  expect_one_line_error(run("train " + fourier), "key 'policy.fourier.inputs': must be observation indices in [0, 28)");
+  auto period = write("period.yaml", "task: walker_jump\npolicy: {fourier: {inputs: [26], periods: [0]}}\n");
+  expect_one_line_error(run("train " + period), "key 'policy.fourier.periods': must be positive");
   auto es_alone = write("es.yaml", "task: walker_jump\nes: {pairs: 4}\n");
   expect_one_line_error(run("train " + es_alone), "es.yaml: key 'es': fine-tunes a trained policy: give init_policy too");
   auto es_ppo = write("es_ppo.yaml", "task: walker_jump\ninit_policy: p.pt\nes: {pairs: 4}\nppo: {lr: 0.1}\n");

@@ -109,6 +109,33 @@ TEST_F(TransitionTraining, ActorStartsAsAPolicyOnAPrefixOfItsObservation) {
   EXPECT_THROW(narrow.init_actor(ppo.policy()), Error);
 }
 
+// pi_b with periodic input features (a jump that reads the curb's phase): pi_ab's network
+// takes them when it starts as pi_b, and then acts exactly as pi_b; not otherwise.
+TEST_F(TransitionTraining, TransitionNetworkTakesNextSkillsFeatures) {
+  VectorEnv envs(task_factory("walker_jump", Recipe::parse("{}", "j").root()), 2, 1);
+  ActorCriticSpec featured;
+  featured.obs_dim = envs.spec().obs_dim, featured.act_dim = envs.spec().act_dim;
+  featured.features = ObsFeatures{{26}, {1.9, 3.8}};
+  PPO jump_trainer(PpoConfig(), featured, envs, 3);
+  jump_trainer.iterate();
+  const Policy jump = jump_trainer.policy();
+
+  TransitionPolicyConfig tp;
+  ActorCriticSpec net = tp.network(envs.spec(), jump);
+  EXPECT_EQ(net.obs_dim, 28);
+  EXPECT_TRUE(net.features == featured.features);
+  PPO pi_ab(tp.ppo, net, envs, 4);
+  pi_ab.init_actor(jump);
+  auto obs = random_obs(8, 28, 5);
+  std::vector<float> want(8 * 6), got(8 * 6);
+  jump.act(obs.data(), 8, want.data());
+  pi_ab.policy().act(obs.data(), 8, got.data());
+  for (size_t i = 0; i < want.size(); ++i) ASSERT_NEAR(got[i], want[i], 1e-5) << i;
+
+  tp.init_from_next = false;
+  EXPECT_TRUE(tp.network(envs.spec(), jump).features.empty());
+}
+
 TEST_F(TransitionTraining, GeneratorRewardsAreEq3OfTheDiscriminator) {
   for (std::string mode : {"airl", "airl_absorbing"}) {
     CompositeRecipe r = tiny({"transition.reward=" + mode, "transition.discriminator.steps=16"});

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Ships a trained skill: exports RUN_DIR/checkpoint.pt to assets/policies/<group>/<task>.pt
 and records provenance in assets/policies/<group>/manifest.json (recipe, seed, environment
-steps, wall time, evaluation) from the run directory's recipe.yaml and eval.json.
+steps, wall time, evaluation, and the policy or checkpoint it started from) from the run
+directory's recipe.yaml and eval.json.
 
 usage: tools/ship_policy.py RECIPE RUN_DIR [--group walker]
 """
@@ -18,6 +19,9 @@ evaluation = json.load(open(os.path.join(args.run_dir, "eval.json")))
 resolved = open(os.path.join(args.run_dir, "recipe.yaml")).read()
 task = next(l.split(":", 1)[1].strip() for l in resolved.splitlines() if l.startswith("task:"))
 seed = next(l.split(":", 1)[1].strip() for l in resolved.splitlines() if l.startswith("seed:"))
+# The policy or checkpoint this stage started from, if any (its own provenance is its entry).
+start = {k: l.split(":", 1)[1].strip().strip('"') for l in resolved.splitlines()
+         for k in ("init_policy", "init_from") if l.startswith(k + ":")}
 out_dir = os.path.join(root, "assets", "policies", args.group)
 os.makedirs(out_dir, exist_ok=True)
 out = os.path.join(out_dir, task + ".pt")
@@ -34,6 +38,7 @@ manifest[task] = {
     "train_threads": evaluation["threads"],
     "eval": {k: evaluation[k] for k in evaluation if k not in ("env_steps", "wall_seconds", "threads")},
 }
+manifest[task].update({k: v for k, v in start.items() if v})
 with open(manifest_path, "w") as f:
     json.dump(manifest, f, indent=2, sort_keys=True)
     f.write("\n")

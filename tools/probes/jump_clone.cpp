@@ -44,11 +44,11 @@ struct Demos {
 // weights.
 Policy clone(const Policy& pi, const Demos& d, int epochs, double lr, uint64_t seed) {
   torch::manual_seed(seed);
-  const int obs_dim = pi.obs_dim(), act_dim = pi.act_dim();
+  const int in_dim = pi.in_dim(), act_dim = pi.act_dim();
   const int64_t n = int64_t(d.act.size()) / act_dim;
-  std::vector<float> x(d.obs.size());
+  std::vector<float> x(size_t(n) * in_dim);
   pi.normalize(d.obs.data(), int(n), x.data());
-  const torch::Tensor X = torch::from_blob(x.data(), {n, obs_dim}).clone();
+  const torch::Tensor X = torch::from_blob(x.data(), {n, in_dim}).clone();
   const torch::Tensor Y = torch::from_blob(const_cast<float*>(d.act.data()), {n, act_dim}).clone();
   std::vector<torch::Tensor> ws, bs;
   for (size_t i = 0; i < pi.mlp().weights().size(); ++i) {

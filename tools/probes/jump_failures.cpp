@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
   std::map<std::string, std::vector<double>> takeoffs;  // outcome -> frontmost footfalls
   std::map<std::string, int> ends;
   const EnvSpec& spec = env->spec();
-  std::vector<float> obs(spec.obs_dim), act(spec.act_dim), x(spec.obs_dim), mu(spec.act_dim);
+  std::vector<float> obs(spec.obs_dim), act(spec.act_dim), x(pi.in_dim()), mu(spec.act_dim);
   std::vector<long> outside(spec.act_dim, 0);
   long total_steps = 0;
   for (int e = 0; e < n; ++e) {
