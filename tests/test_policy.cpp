@@ -160,7 +160,7 @@ TEST_F(PolicyFiles, PeriodicFeaturesSurviveEveryExport) {
     for (int i = 0; i < 7 * 6; ++i) EXPECT_NEAR(a[i], b[i], 1e-6f) << file;
   }
   // The features are inputs the network uses: moving only input 5 by a quarter of 1.7 m
-  // (normalised input 5 pinned by a huge std) changes the action.
+  // changes the action even with its normalised value held at 0 (inv_std 0).
   std::vector<float> x(26, 0.0f), y(26, 0.0f), ax(6), ay(6);
   y[5] = 1.7f / 4;
   std::vector<float> inv_std = mem.obs_inv_std();
