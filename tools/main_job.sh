@@ -4,8 +4,8 @@
 # and T_b, train the transition policy (AIRL), the switch Q-network (double DQN) and Lee
 # et al.'s baseline, then evaluate all five methods. Progress is shown stage by stage;
 # rerunning resumes an interrupted run. The table is written to runs/hurdle/hurdle.md
-# (the shipped one is experiments/results/hurdle.md). Patrol, the task whose skills all
-# meet their targets: build/segue run experiments/patrol.yaml.
+# (the shipped one is experiments/results/hurdle.md). Patrol likewise:
+# build/segue run experiments/patrol.yaml.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
