@@ -35,8 +35,9 @@ StepResult TransitionEnv::step(const float* action, float* obs) {
   StepResult r = task_->step(action, full_.data());
   slice(obs);
   task_->features(features_.data());
+  ++steps_;
   const bool left = !MetaController::holds(transition_.when, features_.data());
-  if (!r.terminated && (left || transition_.capped(++steps_))) r.truncated = true;  // Transition::running
+  if (!r.terminated && (left || transition_.capped(steps_))) r.truncated = true;  // Transition::running
   // A transition episode succeeds when it reaches the interval's end on its feet (not
   // when max_steps cut it short).
   r.info.success = left && !r.terminated;

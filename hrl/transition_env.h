@@ -1,9 +1,10 @@
 #pragma once
 // The environment a transition policy pi_ab trains in (Algorithm 1, lines 8-9): each
 // episode starts from a state sampled from S_a and runs while the transition interval
-// holds (Transition::running). Leaving the interval ends the episode as a time limit (truncated: pi_b takes
-// over from there); the task ending (a fall) ends it for real. pi_ab sees pi_b's slice
-// of the task observation, the space its discriminator compares with T_b.
+// holds (Transition::running). Leaving the interval ends the episode as a time limit
+// (truncated: pi_b takes over from there); the task ending (a fall) ends it for real.
+// pi_ab sees pi_b's slice of the task observation, the space its discriminator compares
+// with T_b.
 #include <memory>
 
 #include "core/rng.h"

@@ -17,11 +17,10 @@ args = ap.parse_args()
 
 evaluation = json.load(open(os.path.join(args.run_dir, "eval.json")))
 resolved = open(os.path.join(args.run_dir, "recipe.yaml")).read()
-task = next(l.split(":", 1)[1].strip() for l in resolved.splitlines() if l.startswith("task:"))
-seed = next(l.split(":", 1)[1].strip() for l in resolved.splitlines() if l.startswith("seed:"))
-# The policy or checkpoint this stage started from, if any (its own provenance is its entry).
-start = {k: l.split(":", 1)[1].strip().strip('"') for l in resolved.splitlines()
-         for k in ("init_policy", "init_from") if l.startswith(k + ":")}
+# The resolved recipe's top-level scalars (task, seed, init_policy, ...), read once.
+top = {k: v.strip().strip('"') for k, v in (l.split(":", 1) for l in resolved.splitlines()
+                                            if ":" in l and not l.startswith((" ", "#")))}
+task, seed = top["task"], top["seed"]
 out_dir = os.path.join(root, "assets", "policies", args.group)
 os.makedirs(out_dir, exist_ok=True)
 out = os.path.join(out_dir, task + ".pt")
@@ -38,7 +37,8 @@ manifest[task] = {
     "train_threads": evaluation["threads"],
     "eval": {k: evaluation[k] for k in evaluation if k not in ("env_steps", "wall_seconds", "threads")},
 }
-manifest[task].update({k: v for k, v in start.items() if v})
+# The policy or checkpoint this stage started from, if any (its own provenance is its entry).
+manifest[task].update({k: top[k] for k in ("init_policy", "init_from") if top.get(k)})
 with open(manifest_path, "w") as f:
     json.dump(manifest, f, indent=2, sort_keys=True)
     f.write("\n")
