@@ -165,8 +165,7 @@ std::vector<int64_t> EvolutionStrategy::load(const std::string& path) {
   if (size_t(theta.numel()) != theta_.size() || m.numel() != theta.numel() || v.numel() != theta.numel())
     throw Error(path + ": checkpoint has " + std::to_string(theta.numel()) + " parameters, the policy " +
                 std::to_string(theta_.size()));
-  auto t = theta.to(torch::kFloat32).contiguous();
-  theta_.assign(t.data_ptr<float>(), t.data_ptr<float>() + t.numel());
+  theta_ = to_floats(theta);
   m_ = from_doubles(m);
   v_ = from_doubles(v);
   generation_ = int(generation.item<int64_t>());

@@ -14,6 +14,11 @@ Activation parse_activation(const std::string& name) {
 
 std::string activation_name(Activation a) { return a == Activation::Tanh ? "tanh" : "relu"; }
 
+std::vector<float> to_floats(const torch::Tensor& t) {
+  auto c = t.detach().to(torch::kFloat32).contiguous();
+  return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
+}
+
 torch::nn::Sequential make_mlp(int in, const std::vector<int>& hidden, int out, Activation act,
                                double out_gain) {
   torch::nn::Sequential net;

@@ -65,10 +65,6 @@ template <class M>
 torch::Tensor mat(const M& m) {
   return torch::from_blob(const_cast<float*>(m.data()), {m.rows(), m.cols()}, torch::kFloat32).clone();
 }
-std::vector<float> to_vec(const torch::Tensor& t) {
-  auto c = t.to(torch::kFloat32).contiguous();
-  return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
-}
 
 }  // namespace
 
@@ -127,9 +123,9 @@ Policy Policy::load_torchscript(const std::string& path) {
     features.periods.assign(per.data_ptr<double>(), per.data_ptr<double>() + per.numel());
   }
   Policy p(EigenMlp(ws, bs, parse_activation(m.attr("activation").toStringRef())),
-           to_vec(m.attr("obs_mean").toTensor()), to_vec(m.attr("obs_inv_std").toTensor()),
-           float(m.attr("obs_clip").toDouble()), to_vec(m.attr("act_low").toTensor()),
-           to_vec(m.attr("act_high").toTensor()), features);
+           to_floats(m.attr("obs_mean").toTensor()), to_floats(m.attr("obs_inv_std").toTensor()),
+           float(m.attr("obs_clip").toDouble()), to_floats(m.attr("act_low").toTensor()),
+           to_floats(m.attr("act_high").toTensor()), features);
   // The Eigen forward must be the function the file defines: check on a random batch.
   torch::manual_seed(0);
   auto obs = torch::randn({8, p.obs_dim()}) * 3.0;

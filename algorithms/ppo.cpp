@@ -80,8 +80,7 @@ void PPO::net_input(const float* raw, float* out) const {
 
 void PPO::refresh_inference_copy() {
   actor_copy_ = EigenMlp(net_->actor, net_->spec.activation);
-  auto ls = net_->log_std.detach().contiguous();
-  log_std_.assign(ls.data_ptr<float>(), ls.data_ptr<float>() + ls.numel());
+  log_std_ = to_floats(net_->log_std);
 }
 
 IterationStats PPO::iterate() {
@@ -434,13 +433,9 @@ Policy PPO::policy_from_checkpoint(const std::string& path) {
   }
   RunningMeanStd rms(spec.obs_dim);
   rms.load(ar, "obs_rms_");
-  auto to_vec = [](const torch::Tensor& t) {
-    auto c = t.to(torch::kFloat32).contiguous();
-    return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
-  };
   return Policy(EigenMlp(net->actor, spec.activation),
                 std::vector<float>(rms.mean().begin(), rms.mean().end()), rms.inv_std(),
-                static_cast<float>(rms.clip()), to_vec(low), to_vec(high), spec.features);
+                static_cast<float>(rms.clip()), to_floats(low), to_floats(high), spec.features);
 }
 
 }  // namespace segue
