@@ -9,6 +9,8 @@
 
 namespace segue {
 
+class Section;
+
 struct ObsFeatures {
   std::vector<int> inputs;       // raw observation indices
   std::vector<double> periods;   // in the observation's units (metres for a distance)
@@ -26,6 +28,9 @@ struct ObsFeatures {
       }
   }
   bool operator==(const ObsFeatures& o) const { return inputs == o.inputs && periods == o.periods; }
+  // A recipe's `fourier: {inputs: [...], periods: [...]}` section, for observations of
+  // width obs_dim (throws segue::Error naming the key).
+  static ObsFeatures read(const Section& f, int obs_dim);
 };
 
 }  // namespace segue

@@ -58,17 +58,8 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   const auto& ig = s.net.ignore_obs;
   if (!ig.empty() && (ig.size() != 2 || ig[0] < 0 || ig[0] >= ig[1] || ig[1] > s.net.obs_dim))
     throw pol.error("ignore_obs", "must be [begin, end) with 0 <= begin < end <= " + std::to_string(s.net.obs_dim));
-  if (pol.has("fourier")) {  // read only when given, so older runs' resolved recipes stay the same
-    Section f = pol.sub("fourier");
-    s.net.features.inputs = f.require<std::vector<int>>("inputs");
-    s.net.features.periods = f.require<std::vector<double>>("periods");
-    for (int i : s.net.features.inputs)
-      if (i < 0 || i >= s.net.obs_dim)
-        throw f.error("inputs", "must be observation indices in [0, " + std::to_string(s.net.obs_dim) + ")");
-    for (double p : s.net.features.periods)
-      if (!(p > 0)) throw f.error("periods", "must be positive");
-    if (s.net.features.empty()) throw f.error("inputs", "needs at least one input and one period");
-  }
+  // Read only when given, so older runs' resolved recipes stay the same.
+  if (pol.has("fourier")) s.net.features = ObsFeatures::read(pol.sub("fourier"), s.net.obs_dim);
   s.net.act_dim = probe->spec().act_dim;
   return s;
 }

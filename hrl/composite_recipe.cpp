@@ -47,7 +47,7 @@ CompositeRecipe CompositeRecipe::load(const std::string& file, const std::vector
   Section methods = root.sub("methods");
   if (methods.has("single")) c.single_policy = methods.sub("single").require<std::string>("policy");
   c.transitions_dir = methods.get<std::string>("transitions", "");
-  c.pipeline = PipelineConfig::read(root, c.task);
+  c.pipeline = PipelineConfig::read(root, c.task, c.spec.obs_dim);
   Section ev = root.sub("eval");
   c.eval_episodes = ev.get("episodes", c.eval_episodes);
   c.eval_seeds = ev.get("seeds", c.eval_seeds);

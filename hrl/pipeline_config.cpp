@@ -47,7 +47,7 @@ ActorCriticSpec TransitionPolicyConfig::network(const EnvSpec& env, const Policy
   return n;
 }
 
-SwitchConfig SwitchConfig::read(const Section& s) {
+SwitchConfig SwitchConfig::read(const Section& s, int obs_dim) {
   SwitchConfig c;
   c.net.hidden = s.get("hidden", c.net.hidden);
   c.net.gamma = s.get("gamma", c.net.gamma);
@@ -67,6 +67,7 @@ SwitchConfig SwitchConfig::read(const Section& s) {
   c.lookahead = s.get("lookahead", c.lookahead);
   c.validation_starts = s.get("validation_starts", c.validation_starts);
   c.margins = s.get("margins", c.margins);
+  if (s.has("fourier")) c.features = ObsFeatures::read(s.sub("fourier"), obs_dim);  // only when given
   if (c.validation_starts < 0) throw s.error("validation_starts", "must be >= 0");
   if (c.margins.empty()) throw s.error("margins", "lists no margin");
   for (double m : c.margins)
@@ -97,14 +98,14 @@ LeeConfig LeeConfig::read(const Section& s) {
   return c;
 }
 
-PipelineConfig PipelineConfig::read(const Section& root, const std::string& task) {
+PipelineConfig PipelineConfig::read(const Section& root, const std::string& task, int obs_dim) {
   PipelineConfig c;
   c.run_dir = root.get("run_dir", "runs/" + task);
   c.seed = root.get<uint64_t>("seed", c.seed);
   c.threads = root.get("threads", c.threads);
   c.collect = CollectConfig::read(root.sub("collect"));
   c.transition = TransitionPolicyConfig::read(root.sub("transition"));
-  c.switching = SwitchConfig::read(root.sub("switch"));
+  c.switching = SwitchConfig::read(root.sub("switch"), obs_dim);
   c.lee = LeeConfig::read(root.sub("lee"));
   return c;
 }

@@ -77,8 +77,12 @@ struct SwitchConfig {
   // makes it switch early for nothing; the held-out check keeps that from costing.
   int validation_starts = 0;
   std::vector<double> margins{0.0, 0.25, 0.5, 1.0, 2.0};
+  // `fourier:` periodic features of q_ab's inputs, as a policy's (algorithms/obs_features.h):
+  // whether a hand-over succeeds can hinge on where in pi_b's stride an obstacle falls.
+  ObsFeatures features;
 
-  static SwitchConfig read(const Section& s);
+  // obs_dim: the composite task's observation width (the features' inputs index it).
+  static SwitchConfig read(const Section& s, int obs_dim);
 };
 
 // Lee et al. 2019's transition policy: the generator's PPO and network are `transition:`'s;
@@ -103,7 +107,7 @@ struct PipelineConfig {
   TransitionPolicyConfig transition;
   SwitchConfig switching;
   LeeConfig lee;
-  static PipelineConfig read(const Section& root, const std::string& task);
+  static PipelineConfig read(const Section& root, const std::string& task, int obs_dim);
 };
 
 }  // namespace segue

@@ -36,12 +36,13 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
                 ") leaves none of S_a's " + std::to_string(starts_.size()) + " states to train on");
   const EnvSpec& spec = env_->spec();
   const int D = spec.obs_dim;
-  full_.resize(D), next_full_.resize(D), scratch_.resize(D), qvals_.resize(2);
+  const int I = D + cfg_.features.size();  // q_ab's input: normalised state, then its features
+  full_.resize(D), next_full_.resize(D), scratch_.resize(I), qvals_.resize(2);
   features_.resize(spec.feature_names.size());
   rng_.seed(seed);
   torch::manual_seed(mix_seed(seed, 0x9));
   SwitchQSpec qs = cfg_.net;
-  qs.obs_dim = D;
+  qs.obs_dim = I;
   q_ = SwitchQNetwork(qs);
   target_ = SwitchQNetwork(qs);
   copy_weights(q_, target_);
@@ -79,6 +80,7 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
 
 void SwitchTrainer::normalize(const float* in, float* out) const {
   for (size_t j = 0; j < mean_.size(); ++j) out[j] = std::clamp((in[j] - mean_[j]) * inv_std_[j], -5.0f, 5.0f);
+  cfg_.features.write(in, out + mean_.size());
 }
 
 bool SwitchTrainer::hand_over(float* obs) {
@@ -93,14 +95,14 @@ int SwitchTrainer::greedy(const float* obs) {
 }
 
 void SwitchTrainer::store(const float* s, int a, double r, const float* s2, bool done) {
-  const int D = int(full_.size());
+  const int I = int(scratch_.size());
   const int64_t cap = cfg_.replay, row = stored_ % cap;
   if (stored_ < cap) {
-    obs_.resize(size_t(row + 1) * D), next_obs_.resize(size_t(row + 1) * D);
+    obs_.resize(size_t(row + 1) * I), next_obs_.resize(size_t(row + 1) * I);
     action_.push_back(0), reward_.push_back(0), done_.push_back(0);
   }
-  normalize(s, &obs_[row * D]);
-  normalize(s2, &next_obs_[row * D]);
+  normalize(s, &obs_[row * I]);
+  normalize(s2, &next_obs_[row * I]);
   action_[row] = a, reward_[row] = float(r), done_[row] = done ? 1.0f : 0.0f;
   ++stored_;
 }
@@ -142,10 +144,10 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
 }
 
 double SwitchTrainer::update() {
-  const int64_t n = std::min<int64_t>(stored_, cfg_.replay), D = int64_t(full_.size());
+  const int64_t n = std::min<int64_t>(stored_, cfg_.replay), I = int64_t(scratch_.size());
   auto idx = torch::randint(n, {cfg_.batch}, torch::kLong);
-  auto obs = torch::from_blob(obs_.data(), {n, D}).index_select(0, idx);
-  auto next = torch::from_blob(next_obs_.data(), {n, D}).index_select(0, idx);
+  auto obs = torch::from_blob(obs_.data(), {n, I}).index_select(0, idx);
+  auto next = torch::from_blob(next_obs_.data(), {n, I}).index_select(0, idx);
   auto action = torch::from_blob(action_.data(), {n}, torch::kLong).index_select(0, idx);
   auto reward = torch::from_blob(reward_.data(), {n}).index_select(0, idx);
   auto done = torch::from_blob(done_.data(), {n}).index_select(0, idx);
@@ -187,7 +189,7 @@ Policy SwitchTrainer::q_function(double margin) const {
   std::vector<float> theta = net.parameters();
   theta[theta.size() - 2 + SwitchQNetworkImpl::kStay] += float(margin);  // the last layer's bias
   net.set_parameters(theta);
-  return Policy(net, mean_, inv_std_, 5.0f, {-inf, -inf}, {inf, inf});
+  return Policy(net, mean_, inv_std_, 5.0f, {-inf, -inf}, {inf, inf}, cfg_.features);
 }
 
 MarginChoice SwitchTrainer::choose_margin() {

@@ -81,7 +81,8 @@ class SwitchTrainer {
   int greedy(const float* obs);
   // pi_b takes over at the state in `obs` (the task observation, updated in place): did it succeed?
   bool hand_over(float* obs);
-  // q_ab's input: (s - mean) / std from the probe, clipped to +-5 (as q_function() exports).
+  // q_ab's input: (s - mean) / std from the probe, clipped to +-5, then switch.fourier's
+  // features of s (as q_function() exports).
   void normalize(const float* in, float* out) const;
 
   SwitchConfig cfg_;

@@ -4,7 +4,9 @@
 // artefact and resumes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -198,6 +200,50 @@ TEST_F(TransitionTraining, SwitchQNetworkExportsAsAPolicy) {
   q.act(obs.data(), 8, a.data());
   back.act(obs.data(), 8, c.data());
   for (int i = 0; i < 16; ++i) EXPECT_NEAR(a[i], c[i], 1e-5);
+}
+
+// switch.fourier: q_ab reads periodic features of chosen observations after its normalised
+// input, as a policy does; the exported q_ab computes exactly that input (by hand here).
+TEST_F(TransitionTraining, SwitchQNetworkReadsPeriodicFeatures) {
+  CompositeRecipe r = tiny({"switch.fourier={inputs: [0, 3], periods: [0.5, 2]}"});
+  const int D = r.spec.obs_dim;
+  const Skill& b = r.skills[r.meta.transitions()[0].to];
+  SwitchTrainer trainer(r.pipeline.switching, r, 0, collect_start_states(r, 0, 6, 1), b.policy, {}, 4);
+  trainer.run(24);
+  Policy q = trainer.q_function();
+  ASSERT_EQ(q.features(), (ObsFeatures{{0, 3}, {0.5, 2}}));
+  ASSERT_EQ(q.mlp().in_dim(), D + 8);
+  auto obs = random_obs(5, D, 7);
+  std::vector<float> got(10), back_got(10), in(D + 8), want(2);
+  q.act(obs.data(), 5, got.data());
+  const double kTwoPi = 6.283185307179586;
+  for (int n = 0; n < 5; ++n) {
+    const float* x = &obs[size_t(n) * D];
+    for (int j = 0; j < D; ++j) in[j] = std::clamp((x[j] - q.obs_mean()[j]) * q.obs_inv_std()[j], -5.0f, 5.0f);
+    int k = D;
+    for (int i : {0, 3})
+      for (double period : {0.5, 2.0}) {
+        in[k++] = float(std::sin(kTwoPi * x[i] / period));
+        in[k++] = float(std::cos(kTwoPi * x[i] / period));
+      }
+    q.mlp().forward(in.data(), 1, want.data());
+    EXPECT_NEAR(got[2 * n], want[0], 1e-5);
+    EXPECT_NEAR(got[2 * n + 1], want[1], 1e-5);
+  }
+  q.export_torchscript(path("qf.pt"));
+  Policy back = Policy::load(path("qf.pt"));
+  EXPECT_EQ(back.features(), q.features());
+  back.act(obs.data(), 5, back_got.data());
+  for (int i = 0; i < 10; ++i) EXPECT_NEAR(back_got[i], got[i], 1e-5);
+  try {
+    tiny({"switch.fourier={inputs: [" + std::to_string(D) + "], periods: [1]}"});
+    ADD_FAILURE() << "an input past the observation was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'switch.fourier.inputs': must be observation indices in [0, " +
+                                         std::to_string(D) + ")"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // The switch margin is chosen on held-out S_a states: each margin's success rate equals a
