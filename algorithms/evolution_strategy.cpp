@@ -128,10 +128,6 @@ double EvolutionStrategy::tell(const std::vector<double>& fitness) {
 namespace {
 
 torch::Tensor doubles(const std::vector<double>& v) { return torch::tensor(v, torch::kFloat64); }
-std::vector<double> from_doubles(const torch::Tensor& t) {
-  auto c = t.to(torch::kFloat64).contiguous();
-  return std::vector<double>(c.data_ptr<double>(), c.data_ptr<double>() + c.numel());
-}
 
 }  // namespace
 
@@ -166,8 +162,8 @@ std::vector<int64_t> EvolutionStrategy::load(const std::string& path) {
     throw Error(path + ": checkpoint has " + std::to_string(theta.numel()) + " parameters, the policy " +
                 std::to_string(theta_.size()));
   theta_ = to_floats(theta);
-  m_ = from_doubles(m);
-  v_ = from_doubles(v);
+  m_ = to_doubles(m);
+  v_ = to_doubles(v);
   generation_ = int(generation.item<int64_t>());
   auto c = counters.to(torch::kLong).contiguous();
   return std::vector<int64_t>(c.data_ptr<int64_t>(), c.data_ptr<int64_t>() + c.numel());

@@ -14,10 +14,17 @@ Activation parse_activation(const std::string& name) {
 
 std::string activation_name(Activation a) { return a == Activation::Tanh ? "tanh" : "relu"; }
 
-std::vector<float> to_floats(const torch::Tensor& t) {
-  auto c = t.detach().to(torch::kFloat32).contiguous();
-  return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
+namespace {
+template <class T, class Stored>
+std::vector<T> to_vector(const torch::Tensor& t, torch::ScalarType dtype) {
+  auto c = t.detach().to(dtype).contiguous();
+  return std::vector<T>(c.data_ptr<Stored>(), c.data_ptr<Stored>() + c.numel());
 }
+}  // namespace
+
+std::vector<float> to_floats(const torch::Tensor& t) { return to_vector<float, float>(t, torch::kFloat32); }
+std::vector<double> to_doubles(const torch::Tensor& t) { return to_vector<double, double>(t, torch::kFloat64); }
+std::vector<int> to_ints(const torch::Tensor& t) { return to_vector<int, int64_t>(t, torch::kLong); }
 
 torch::nn::Sequential make_mlp(int in, const std::vector<int>& hidden, int out, Activation act,
                                double out_gain) {

@@ -15,8 +15,11 @@ enum class Activation { Tanh, Relu };
 Activation parse_activation(const std::string& name);  // throws segue::Error
 std::string activation_name(Activation a);
 
-// A tensor's values as plain floats (any dtype, any layout), for the Eigen side.
+// A tensor's values as a plain vector (any dtype, any layout), for the Eigen side and
+// for reading archives.
 std::vector<float> to_floats(const torch::Tensor& t);
+std::vector<double> to_doubles(const torch::Tensor& t);
+std::vector<int> to_ints(const torch::Tensor& t);
 
 // Linear layers in→hidden...→out, `act` between them, none after the last. Hidden layers
 // get orthogonal init with gain sqrt(2); the last layer uses `out_gain` (small for a

@@ -117,10 +117,8 @@ Policy Policy::load_torchscript(const std::string& path) {
   if (ws.empty()) throw Error(path + ": not a Segue policy (no layers w0, b0, ...)");
   ObsFeatures features;
   if (m.hasattr("feature_inputs")) {
-    auto in = m.attr("feature_inputs").toTensor().to(torch::kLong).contiguous();
-    auto per = m.attr("feature_periods").toTensor().to(torch::kFloat64).contiguous();
-    features.inputs.assign(in.data_ptr<int64_t>(), in.data_ptr<int64_t>() + in.numel());
-    features.periods.assign(per.data_ptr<double>(), per.data_ptr<double>() + per.numel());
+    features.inputs = to_ints(m.attr("feature_inputs").toTensor());
+    features.periods = to_doubles(m.attr("feature_periods").toTensor());
   }
   Policy p(EigenMlp(ws, bs, parse_activation(m.attr("activation").toStringRef())),
            to_floats(m.attr("obs_mean").toTensor()), to_floats(m.attr("obs_inv_std").toTensor()),

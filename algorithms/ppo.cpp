@@ -325,11 +325,6 @@ std::string key(std::string name) {
   return "ac_" + name;
 }
 torch::Tensor ints(const std::vector<int64_t>& v) { return torch::tensor(v, torch::kLong); }
-std::vector<int> to_ints(const torch::Tensor& t) {
-  std::vector<int> v;
-  for (int64_t i = 0; i < t.numel(); ++i) v.push_back(static_cast<int>(t[i].item<int64_t>()));
-  return v;
-}
 std::vector<int64_t> widen(const std::vector<int>& v) { return {v.begin(), v.end()}; }
 // The periodic features, if any (older checkpoints have none).
 void write_features(torch::serialize::OutputArchive& ar, const ObsFeatures& f) {
@@ -343,8 +338,7 @@ ObsFeatures read_features(torch::serialize::InputArchive& ar) {
   if (!ar.try_read("meta_feature_inputs", in)) return f;
   ar.read("meta_feature_periods", per);
   f.inputs = to_ints(in);
-  per = per.contiguous();
-  f.periods.assign(per.data_ptr<double>(), per.data_ptr<double>() + per.numel());
+  f.periods = to_doubles(per);
   return f;
 }
 
