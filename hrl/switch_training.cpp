@@ -36,13 +36,12 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
                 ") leaves none of S_a's " + std::to_string(starts_.size()) + " states to train on");
   const EnvSpec& spec = env_->spec();
   const int D = spec.obs_dim;
-  const int I = D + cfg_.features.size();  // q_ab's input: normalised state, then its features
-  full_.resize(D), next_full_.resize(D), scratch_.resize(I), qvals_.resize(2);
+  full_.resize(D), next_full_.resize(D), scratch_.resize(D), qvals_.resize(2);
   features_.resize(spec.feature_names.size());
   rng_.seed(seed);
   torch::manual_seed(mix_seed(seed, 0x9));
   SwitchQSpec qs = cfg_.net;
-  qs.obs_dim = I;
+  qs.obs_dim = D + cfg_.features.size();  // q_ab's input: normalised state, then its features
   q_ = SwitchQNetwork(qs);
   target_ = SwitchQNetwork(qs);
   copy_weights(q_, target_);
@@ -69,18 +68,14 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
     }
   }
   interval_length_ = std::max<int>(1, int(steps / probes));
-  mean_.resize(D), inv_std_.resize(D);
+  std::vector<float> mean(D), inv_std(D);
   for (int j = 0; j < D; ++j) {
     double m = sum[j] / rows, var = std::max(sq[j] / rows - m * m, 0.0);
-    mean_[j] = float(m);
-    inv_std_[j] = float(1.0 / std::max(std::sqrt(var), 1e-2));
+    mean[j] = float(m);
+    inv_std[j] = float(1.0 / std::max(std::sqrt(var), 1e-2));
   }
-  q_copy_ = EigenMlp(q_->q, Activation::Relu);
-}
-
-void SwitchTrainer::normalize(const float* in, float* out) const {
-  for (size_t j = 0; j < mean_.size(); ++j) out[j] = std::clamp((in[j] - mean_[j]) * inv_std_[j], -5.0f, 5.0f);
-  cfg_.features.write(in, out + mean_.size());
+  const float inf = std::numeric_limits<float>::infinity();
+  q_ab_ = Policy(EigenMlp(q_->q, Activation::Relu), mean, inv_std, 5.0f, {-inf, -inf}, {inf, inf}, cfg_.features);
 }
 
 bool SwitchTrainer::hand_over(float* obs) {
@@ -88,21 +83,20 @@ bool SwitchTrainer::hand_over(float* obs) {
 }
 
 int SwitchTrainer::greedy(const float* obs) {
-  normalize(obs, scratch_.data());
-  q_copy_.forward(scratch_.data(), 1, qvals_.data());
+  q_ab_.act(obs, 1, qvals_.data());
   return qvals_[SwitchQNetworkImpl::kSwitch] > qvals_[SwitchQNetworkImpl::kStay] ? SwitchQNetworkImpl::kSwitch
                                                                                  : SwitchQNetworkImpl::kStay;
 }
 
 void SwitchTrainer::store(const float* s, int a, double r, const float* s2, bool done) {
-  const int I = int(scratch_.size());
+  const int I = q_ab_.in_dim();
   const int64_t cap = cfg_.replay, row = stored_ % cap;
   if (stored_ < cap) {
     obs_.resize(size_t(row + 1) * I), next_obs_.resize(size_t(row + 1) * I);
     action_.push_back(0), reward_.push_back(0), done_.push_back(0);
   }
-  normalize(s, &obs_[row * I]);
-  normalize(s2, &next_obs_[row * I]);
+  q_ab_.normalize(s, 1, &obs_[row * I]);
+  q_ab_.normalize(s2, 1, &next_obs_[row * I]);
   action_[row] = a, reward_[row] = float(r), done_[row] = done ? 1.0f : 0.0f;
   ++stored_;
 }
@@ -144,7 +138,7 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
 }
 
 double SwitchTrainer::update() {
-  const int64_t n = std::min<int64_t>(stored_, cfg_.replay), I = int64_t(scratch_.size());
+  const int64_t n = std::min<int64_t>(stored_, cfg_.replay), I = q_ab_.in_dim();
   auto idx = torch::randint(n, {cfg_.batch}, torch::kLong);
   auto obs = torch::from_blob(obs_.data(), {n, I}).index_select(0, idx);
   auto next = torch::from_blob(next_obs_.data(), {n, I}).index_select(0, idx);
@@ -175,7 +169,7 @@ SwitchStats SwitchTrainer::run(int n) {
     s.epsilon = eps;
     if (stored_ >= cfg_.warmup) {
       for (int u = 0; u < cfg_.updates_per_attempt; ++u, ++updates) s.loss += update();
-      q_copy_ = EigenMlp(q_->q, Activation::Relu);
+      q_ab_ = q_function();
     }
   }
   if (s.attempts) s.success_rate /= s.attempts, s.switch_step /= s.attempts;
@@ -184,12 +178,9 @@ SwitchStats SwitchTrainer::run(int n) {
 }
 
 Policy SwitchTrainer::q_function(double margin) const {
-  const float inf = std::numeric_limits<float>::infinity();
-  EigenMlp net(q_->q, Activation::Relu);
-  std::vector<float> theta = net.parameters();
+  std::vector<float> theta = EigenMlp(q_->q, Activation::Relu).parameters();
   theta[theta.size() - 2 + SwitchQNetworkImpl::kStay] += float(margin);  // the last layer's bias
-  net.set_parameters(theta);
-  return Policy(net, mean_, inv_std_, 5.0f, {-inf, -inf}, {inf, inf}, cfg_.features);
+  return q_ab_.with_parameters(theta);
 }
 
 MarginChoice SwitchTrainer::choose_margin() {
@@ -209,8 +200,7 @@ MarginChoice SwitchTrainer::choose_margin() {
     for (int t = 0;; ++t) {
       path.emplace_back();
       env_->save_state(path.back());
-      normalize(full_.data(), scratch_.data());
-      q_copy_.forward(scratch_.data(), 1, qvals_.data());
+      q_ab_.act(full_.data(), 1, qvals_.data());
       gap.push_back(qvals_[SwitchQNetworkImpl::kSwitch] - qvals_[SwitchQNetworkImpl::kStay]);
       pi_ab_.act(full_.data() + b.obs_begin, 1, act.data());
       StepResult sr = env_->step(act.data(), full_.data());

@@ -81,9 +81,6 @@ class SwitchTrainer {
   int greedy(const float* obs);
   // pi_b takes over at the state in `obs` (the task observation, updated in place): did it succeed?
   bool hand_over(float* obs);
-  // q_ab's input: (s - mean) / std from the probe, clipped to +-5, then switch.fourier's
-  // features of s (as q_function() exports).
-  void normalize(const float* in, float* out) const;
 
   SwitchConfig cfg_;
   const CompositeRecipe& recipe_;
@@ -94,8 +91,9 @@ class SwitchTrainer {
   TransitionController after_;  // judges a hand-over: pi_b, then With TP (run_subtask)
   SwitchQNetwork q_{nullptr}, target_{nullptr};
   std::unique_ptr<torch::optim::Adam> opt_;
-  EigenMlp q_copy_;  // per-step inference
-  std::vector<float> mean_, inv_std_;
+  // q_ab for per-step inference, as q_function() exports it: input (s - mean) / std from
+  // the probe clipped to +-5, then switch.fourier's features of s; refreshed after updates.
+  Policy q_ab_;
   Rng rng_;
   // Replay buffer, a ring of `replay` rows.
   std::vector<float> obs_, next_obs_;
