@@ -3,8 +3,8 @@
 namespace segue {
 
 DiscriminatorImpl::DiscriminatorImpl(const DiscriminatorSpec& s) : spec(s) {
-  g = register_module("g", make_mlp(s.obs_dim + s.act_dim, s.hidden, 1, Activation::Relu, 1.0));
-  h = register_module("h", make_mlp(s.obs_dim, s.hidden, 1, Activation::Relu, 1.0));
+  g = register_module("g", make_mlp(s.state_dim() + s.act_dim, s.hidden, 1, Activation::Relu, 1.0));
+  h = register_module("h", make_mlp(s.state_dim(), s.hidden, 1, Activation::Relu, 1.0));
   obs_mean = register_buffer("obs_mean", torch::zeros({s.obs_dim}));
   obs_std = register_buffer("obs_std", torch::ones({s.obs_dim}));
   act_mean = register_buffer("act_mean", torch::zeros({s.act_dim}));
@@ -20,13 +20,24 @@ void DiscriminatorImpl::set_normalizer(const torch::Tensor& om, const torch::Ten
   act_std.copy_(as.clamp_min(1e-6));
 }
 
-torch::Tensor DiscriminatorImpl::norm_obs(const torch::Tensor& o) const {
-  return ((o - obs_mean) / obs_std).clamp(-5.0, 5.0);
+torch::Tensor DiscriminatorImpl::state_input(const torch::Tensor& o) const {
+  auto s = ((o - obs_mean) / obs_std).clamp(-5.0, 5.0);
+  if (spec.features.empty()) return s;
+  // The order of ObsFeatures::write: per input, per period, sin then cos.
+  constexpr double kTwoPi = 6.283185307179586476925;
+  std::vector<torch::Tensor> cols{s};
+  for (int i : spec.features.inputs)
+    for (double p : spec.features.periods) {
+      auto phase = o.select(-1, i).unsqueeze(-1) * (kTwoPi / p);
+      cols.push_back(torch::sin(phase));
+      cols.push_back(torch::cos(phase));
+    }
+  return torch::cat(cols, -1);
 }
 
 torch::Tensor DiscriminatorImpl::f(const torch::Tensor& obs, const torch::Tensor& act, const torch::Tensor& next_obs,
                                    const torch::Tensor& done) {
-  auto s = norm_obs(obs), s2 = norm_obs(next_obs);
+  auto s = state_input(obs), s2 = state_input(next_obs);
   auto a = ((act - act_mean) / act_std).clamp(-5.0, 5.0);
   auto reward = g->forward(torch::cat({s, a}, -1)).squeeze(-1);
   auto shaping = spec.gamma * (1.0 - done) * h->forward(s2).squeeze(-1) - h->forward(s).squeeze(-1);

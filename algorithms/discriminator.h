@@ -5,10 +5,12 @@
 // trained by logistic regression: expert transitions (pi_b's, label 1) against the
 // generator's (pi_ab's, label 0). The logit of D is f - log pi(a|s), so
 //   Discriminator::reward = log D - log(1 - D) = f - log pi(a|s)      (Eq. 3)
-// Inputs are normalised with the expert data's mean and std, clipped to +-5 (reference).
+// Inputs are normalised with the expert data's mean and std, clipped to +-5 (reference),
+// optionally followed by periodic features of raw inputs (algorithms/obs_features.h).
 #include <torch/torch.h>
 
 #include "algorithms/mlp.h"
+#include "algorithms/obs_features.h"
 
 namespace segue {
 
@@ -16,6 +18,10 @@ struct DiscriminatorSpec {
   int obs_dim = 0, act_dim = 0;
   std::vector<int> hidden{100, 100};  // g and h: 2 x 100 ReLU each (spec)
   double gamma = 0.99;
+  // Periodic features of s appended to g's and h's state input, so D can tell states by
+  // their phase, e.g. where a gait meets a curb (what pi_b's own features let it see).
+  ObsFeatures features;
+  int state_dim() const { return obs_dim + features.size(); }
 };
 
 class DiscriminatorImpl : public torch::nn::Module {
@@ -42,7 +48,8 @@ class DiscriminatorImpl : public torch::nn::Module {
   torch::Tensor obs_mean, obs_std, act_mean, act_std;  // buffers
 
  private:
-  torch::Tensor norm_obs(const torch::Tensor& o) const;
+  // s's input to g and h: normalised s, then its periodic features.
+  torch::Tensor state_input(const torch::Tensor& o) const;
 };
 TORCH_MODULE(Discriminator);
 

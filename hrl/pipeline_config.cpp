@@ -13,7 +13,7 @@ CollectConfig CollectConfig::read(const Section& s) {
   return c;
 }
 
-TransitionPolicyConfig TransitionPolicyConfig::read(const Section& s) {
+TransitionPolicyConfig TransitionPolicyConfig::read(const Section& s, int obs_dim) {
   TransitionPolicyConfig c;
   c.ppo.lr = 1e-4;  // policy Adam 1e-4 (spec)
   c.ppo.total_steps = 1'000'000;
@@ -33,6 +33,7 @@ TransitionPolicyConfig TransitionPolicyConfig::read(const Section& s) {
   c.disc_lr = d.get("lr", c.disc_lr);
   c.disc_batch = d.get("batch", c.disc_batch);
   c.disc_steps = d.get("steps", c.disc_steps);
+  if (d.has("fourier")) c.discriminator.features = ObsFeatures::read(d.sub("fourier"), obs_dim);
   if (c.disc_batch <= 0) throw d.error("batch", "must be positive");
   if (c.disc_steps < 0) throw d.error("steps", "must be >= 0");
   if (!(c.disc_lr > 0)) throw d.error("lr", "must be positive");
@@ -104,7 +105,7 @@ PipelineConfig PipelineConfig::read(const Section& root, const std::string& task
   c.seed = root.get<uint64_t>("seed", c.seed);
   c.threads = root.get("threads", c.threads);
   c.collect = CollectConfig::read(root.sub("collect"));
-  c.transition = TransitionPolicyConfig::read(root.sub("transition"));
+  c.transition = TransitionPolicyConfig::read(root.sub("transition"), obs_dim);
   c.switching = SwitchConfig::read(root.sub("switch"), obs_dim);
   c.lee = LeeConfig::read(root.sub("lee"));
   return c;

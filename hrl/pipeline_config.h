@@ -6,7 +6,8 @@
 //   seed: 1
 //   threads: 0
 //   collect: {start_states: 1000, demonstrations: 100000}     # |S_a|, |T_b| per transition
-//   transition: {ppo: {...}, policy: {...}, init_from_next: true, discriminator: {...}}
+//   transition: {ppo: {...}, policy: {...}, init_from_next: true,
+//                discriminator: {hidden: [100, 100], lr: 3.0e-4, batch: 256, steps: 16, fourier: {...}}}
 //   switch: {attempts: 2000, lr: 1.0e-4, ...}
 #include <string>
 #include <vector>
@@ -44,8 +45,9 @@ struct TransitionPolicyConfig {
   int disc_batch = 256;          // expert and generator rows per discriminator step, each
   int disc_steps = 16;           // discriminator steps per PPO iteration
 
-  // Reads the recipe's `transition:` section (every key has a default).
-  static TransitionPolicyConfig read(const Section& s);
+  // Reads the recipe's `transition:` section (every key has a default) for observations
+  // of width obs_dim.
+  static TransitionPolicyConfig read(const Section& s, int obs_dim);
   // pi_ab's network on its environment: sized to it and, when pi_ab starts as pi_b
   // (init_from_next), with pi_b's periodic input features, so it can start as exactly pi_b.
   ActorCriticSpec network(const EnvSpec& env, const Policy& next) const;

@@ -79,6 +79,25 @@ TEST(Discriminator, NormalisesInputsWithExpertStatisticsClippedAtFive) {
   EXPECT_NEAR(f[1].item<float>(), 5.0, 1e-6);  // (100 - 10) / 2 = 45, clipped
 }
 
+// transition.discriminator.fourier: g and h read [normalised s, sin, cos of 2 pi s_i / P].
+TEST(Discriminator, PeriodicStateFeaturesByHand) {
+  DiscriminatorSpec spec;
+  spec.obs_dim = 1;
+  spec.act_dim = 1;
+  spec.hidden = {};
+  spec.gamma = 0.9;
+  spec.features = ObsFeatures{{0}, {4.0}};
+  Discriminator d(spec);
+  ASSERT_EQ(spec.state_dim(), 3);
+  set_linear(d->g, {1, 2, 3, 4}, {0}, 1, 4);  // g = s + 2 sin + 3 cos + 4 a
+  set_linear(d->h, {1, 1, 1}, {0}, 1, 3);     // h = s + sin + cos
+  d->set_normalizer(torch::tensor({0.0f}), torch::tensor({1.0f}), torch::tensor({0.0f}), torch::tensor({1.0f}));
+  // s = 1: phase pi/2, (sin, cos) = (1, 0); s' = 2: phase pi, (0, -1).
+  // g = 1 + 2 + 0 + 4 * 0.5 = 5; h(s) = 2; h(s') = 1; f = 5 + 0.9 * 1 - 2 = 3.9.
+  auto f = d->f(torch::tensor({{1.0f}}), torch::tensor({{0.5f}}), torch::tensor({{2.0f}}), torch::zeros({1}));
+  EXPECT_NEAR(f[0].item<float>(), 3.9, 1e-5);
+}
+
 TEST(SwitchQNetwork, DoubleDqnTargetByHand) {
   SwitchQSpec spec;
   spec.obs_dim = 1;

@@ -235,6 +235,16 @@ TEST_F(TransitionTraining, SwitchQNetworkReadsPeriodicFeatures) {
   EXPECT_EQ(back.features(), q.features());
   back.act(obs.data(), 5, back_got.data());
   for (int i = 0; i < 10; ++i) EXPECT_NEAR(back_got[i], got[i], 1e-5);
+  // The discriminator's features are read from the recipe the same way.
+  CompositeRecipe rd = tiny({"transition.discriminator.fourier={inputs: [3], periods: [2]}"});
+  EXPECT_EQ(rd.pipeline.transition.discriminator.features, (ObsFeatures{{3}, {2}}));
+  try {
+    tiny({"transition.discriminator.fourier={inputs: [" + std::to_string(D) + "], periods: [1]}"});
+    ADD_FAILURE() << "an input past the observation was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'transition.discriminator.fourier.inputs'"), std::string::npos)
+        << e.what();
+  }
   try {
     tiny({"switch.fourier={inputs: [" + std::to_string(D) + "], periods: [1]}"});
     ADD_FAILURE() << "an input past the observation was accepted";
