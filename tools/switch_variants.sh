@@ -22,7 +22,7 @@ run=runs/switch_$name
 mkdir -p "$run/walk-jump" "$run/jump-walk"
 if [ -n "$base" ]; then
   cp -n "$base"/walk-jump/{start_states.pt,demonstrations.pt} "$run/walk-jump/"
-  cp -n "$base"/jump-walk/{start_states.pt,demonstrations.pt,policy.pt,q.pt,margins.csv} "$run/jump-walk/"
+  cp -n "$base"/jump-walk/{start_states.pt,demonstrations.pt,policy.pt,q.pt} "$run/jump-walk/"
   overrides=()
 else
   for t in walk-jump jump-walk; do
