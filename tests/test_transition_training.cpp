@@ -242,24 +242,27 @@ TEST_F(TransitionTraining, SwitchQNetworkReadsPeriodicFeatures) {
   EXPECT_EQ(back.features(), q.features());
   back.act(obs.data(), 5, back_got.data());
   for (int i = 0; i < 10; ++i) EXPECT_NEAR(back_got[i], got[i], 1e-5);
-  // The discriminator's features are read from the recipe the same way.
-  CompositeRecipe rd = tiny({"transition.discriminator.fourier={inputs: [3], periods: [2]}"});
-  EXPECT_EQ(rd.pipeline.transition.discriminator.features, (ObsFeatures{{3}, {2}}));
-  try {
-    tiny({"transition.discriminator.fourier={inputs: [" + std::to_string(D) + "], periods: [1]}"});
-    ADD_FAILURE() << "an input past the observation was accepted";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("key 'transition.discriminator.fourier.inputs'"), std::string::npos)
-        << e.what();
-  }
-  try {
-    tiny({"switch.fourier={inputs: [" + std::to_string(D) + "], periods: [1]}"});
-    ADD_FAILURE() << "an input past the observation was accepted";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("key 'switch.fourier.inputs': must be observation indices in [0, " +
-                                         std::to_string(D) + ")"),
-              std::string::npos)
-        << e.what();
+}
+
+// Both recipe keys for periodic features of the task's observation, q_ab's and D's, are
+// read the same way and refuse an input past the observation, naming the key.
+TEST_F(TransitionTraining, PeriodicFeatureKeysAreReadAgainstTheObservation) {
+  const int D = tiny().spec.obs_dim;
+  for (std::string key : {"switch.fourier", "transition.discriminator.fourier"}) {
+    SCOPED_TRACE(key);
+    CompositeRecipe r = tiny({key + "={inputs: [0, 3], periods: [0.5, 2]}"});
+    const ObsFeatures& read =
+        key == "switch.fourier" ? r.pipeline.switching.features : r.pipeline.transition.discriminator.features;
+    EXPECT_EQ(read, (ObsFeatures{{0, 3}, {0.5, 2}}));
+    try {
+      tiny({key + "={inputs: [" + std::to_string(D) + "], periods: [1]}"});
+      ADD_FAILURE() << "an input past the observation was accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("key '" + key + ".inputs': must be observation indices in [0, " +
+                                           std::to_string(D) + ")"),
+                std::string::npos)
+          << e.what();
+    }
   }
 }
 
