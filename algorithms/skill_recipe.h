@@ -20,6 +20,9 @@
 //   eval: {episodes: 50, seed: 1000, reference_task: false}
 //   es: {...}                 # instead of ppo: fine-tune init_policy with evolution
 //                             # strategies (see EsConfig); policy and ppo do not apply
+//   lead_in: {policy: FILE, when: {curb_ahead: [3, 4]}, share: 0.5}  # optional: training
+//                             # episodes begin where another skill hands over (hrl/lead_in.h;
+//                             # read by segue train, as it needs a composing skill)
 //
 // eval.reference_task: judge the trained skill on the task with every env key at its
 // reference value (a recipe may train on an easier or reshaped version, e.g. a curb

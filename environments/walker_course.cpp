@@ -35,21 +35,12 @@ bool WalkerCourse::near_ceiling() const {
 }
 
 void WalkerCourse::features(double* out) const {
-  double x = min_x();
+  const double x = min_x();
   out[0] = out[1] = out[2] = out[3] = kFar;
   out[4] = t_;
   out[5] = std::abs(torso_x() - start_x_);
-  // Next obstacle whose start is ahead, and the last whose end is behind.
-  for (const auto& o : obstacles_)
-    if (o.start > x) {
-      out[o.kind == ObstacleKind::Curb ? 0 : 2] = o.start - x;
-      break;
-    }
-  for (auto it = obstacles_.rbegin(); it != obstacles_.rend(); ++it)
-    if (it->end < x) {
-      out[it->kind == ObstacleKind::Curb ? 1 : 3] = x - it->end;
-      break;
-    }
+  if (const Obstacle* o = obstacle_ahead()) out[o->kind == ObstacleKind::Curb ? 0 : 2] = o->start - x;
+  if (const Obstacle* o = obstacle_behind()) out[o->kind == ObstacleKind::Curb ? 1 : 3] = x - o->end;
 }
 
 StepResult WalkerCourse::evaluate(const float* action) {

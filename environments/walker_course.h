@@ -27,7 +27,6 @@ class WalkerCourse : public WalkerObstacleEnv {
   // the last obstacle behind x when of that kind, else far), steps (since the episode
   // start) and distance (|torso x - its start x|).
   void features(double* out) const override;
-  static constexpr double kFar = 1e6;
 
  protected:
   void reset_task() override;

@@ -105,6 +105,20 @@ void WalkerObstacleEnv::obstacle_observation(double& start, double& end) const {
   }
 }
 
+const Obstacle* WalkerObstacleEnv::obstacle_ahead() const {
+  const double x = min_x();
+  for (const auto& o : obstacles_)
+    if (o.start > x) return &o;
+  return nullptr;
+}
+
+const Obstacle* WalkerObstacleEnv::obstacle_behind() const {
+  const double x = min_x();
+  for (auto it = obstacles_.rbegin(); it != obstacles_.rend(); ++it)
+    if (it->end < x) return &*it;
+  return nullptr;
+}
+
 bool WalkerObstacleEnv::touching(int kind) const {
   for (int c = 0; c < data_->ncon; ++c) {
     int k1 = geom_kind_[data_->contact[c].geom1], k2 = geom_kind_[data_->contact[c].geom2];
@@ -158,6 +172,7 @@ void WalkerObstacleEnv::restore_task_state(const double* in, size_t n) {
 
 WalkerJump::WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c)
     : WalkerObstacleEnv(name, w, o, true), jcfg_(c) {
+  spec_.feature_names = {"curb_ahead", "curb_behind"};
   if (jcfg_.ghost_curbs) make_curbs_ghosts();
   for (int g = 0; g < model_->ngeom; ++g)
     if (model_->geom_bodyid[g] != 0 && model_->geom_type[g] == mjGEOM_CAPSULE) walker_capsules_.push_back(g);
@@ -175,6 +190,13 @@ double WalkerJump::depth_in_curb(size_t k) const {
                                   model_->geom_size[3 * g], c.start, c.end, height);
   }
   return depth;
+}
+
+void WalkerJump::features(double* out) const {
+  const Obstacle* ahead = obstacle_ahead();
+  const Obstacle* behind = obstacle_behind();
+  out[0] = ahead ? ahead->start - min_x() : kFar;
+  out[1] = behind ? min_x() - behind->end : kFar;
 }
 
 void WalkerJump::reset_task() {

@@ -52,6 +52,11 @@ class WalkerObstacleEnv : public WalkerEnv {
   bool touching(int kind = 0) const;
   // The observation pair for the next obstacle (far values if none is near).
   void obstacle_observation(double& start, double& end) const;
+  // The first obstacle whose start is still ahead of x, and the last whose end is behind
+  // it (nullptr when there is none): what the tasks' features measure from.
+  const Obstacle* obstacle_ahead() const;
+  const Obstacle* obstacle_behind() const;
+  static constexpr double kFar = 1e6;  // a feature's value when no obstacle is there
 
  protected:
   // Moves the model's obstacle geoms to this layout; unused ones are parked.
@@ -153,6 +158,10 @@ class WalkerJump : public WalkerObstacleEnv {
     double approach_speed = 0.0, approach_from = 3.0, approach_to = 1.5;
   };
   WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
+  // Features, as Hurdle's: curb_ahead (metres from x to the next curb's start, far when
+  // none) and curb_behind (metres past the last curb's end). A skill recipe's lead_in
+  // reads them (hrl/lead_in.h).
+  void features(double* out) const override;
   // Summed depth of the walker's capsules in curb k's box (capsule_depth_in_box): what
   // ghost curbs charge; with solid curbs MuJoCo keeps it near 0.
   double depth_in_curb(size_t k) const;

@@ -16,6 +16,8 @@ int find_skill(const Section& s, const std::string& key, const std::vector<Skill
   return i;
 }
 
+}  // namespace
+
 std::vector<Condition> read_when(const Section& s, const std::vector<std::string>& features) {
   std::vector<Condition> when;
   if (!s.has("when")) return when;
@@ -34,8 +36,6 @@ std::vector<Condition> read_when(const Section& s, const std::vector<std::string
   }
   return when;
 }
-
-}  // namespace
 
 MetaController::MetaController(const Section& root, const std::vector<Skill>& skills,
                                const std::vector<std::string>& features) {

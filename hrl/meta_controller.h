@@ -53,6 +53,10 @@ struct Transition {
   bool running(const double* features, int steps) const;
 };
 
+// Reads s's `when:` mapping over these feature names (none: always holds); an unknown
+// feature or a bad range is a one-line error naming the key.
+std::vector<Condition> read_when(const Section& s, const std::vector<std::string>& features);
+
 class MetaController {
  public:
   MetaController() = default;

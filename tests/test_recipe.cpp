@@ -130,6 +130,11 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run("train " + es_alone + " --set es.sigma=0"), "key 'es.sigma': must be positive");
   expect_one_line_error(run("train " + es_alone + " --set es.fitness=speed"), "key 'es.fitness': must be 'success' or 'return'");
   expect_one_line_error(run("train " + es_alone + " --set 'es.inputs=[28, 26]'"), "key 'es.inputs': must be [begin, end)");
+  auto lead = write("lead.yaml", "task: walker_jump\nlead_in: {policy: nowhere.pt, when: {curb_ahead: [3, 4]}}\n");
+  expect_one_line_error(run("train " + lead), "lead.yaml: key 'lead_in.policy': no such policy 'nowhere.pt'");
+  expect_one_line_error(run("train " + lead + " --set lead_in.policy=assets/policies/walker/walker_forward.pt"
+                                              " --set 'lead_in.when={hurdle_ahead: [3, 4]}'"),
+                        "key 'lead_in.when.hurdle_ahead': the task has no feature 'hurdle_ahead' (features: curb_ahead, curb_behind)");
   auto curbs = write("curbs.yaml", "task: walker_jump\nenv: {curbs: 0}\n");
   expect_one_line_error(run("train " + curbs), "key 'env.curbs': must be at least 1");
   // A composite recipe's transition and switch keys are checked when it is read.

@@ -8,6 +8,7 @@
 #include <spdlog/spdlog.h>
 
 #include "hrl/evaluation.h"
+#include "hrl/lead_in.h"
 #include "algorithms/skill_recipe.h"
 #include "core/assets.h"
 #include "core/progress.h"
@@ -143,6 +144,8 @@ int train_main(int argc, char** argv) {
   Recipe recipe = Recipe::load(recipe_path, sets);
   std::string stem = std::filesystem::path(recipe_path).stem().string();
   SkillRecipe s = SkillRecipe::read(recipe, "runs/" + stem);
+  if (recipe.root().has("lead_in"))  // training episodes only: eval_make_env keeps the task's start
+    s.make_env = with_lead_in(s.make_env, LeadIn::read(recipe.root().sub("lead_in"), s.make_env()->spec()));
   recipe.reject_unknown();
 
   const int threads = resolve_threads(s.threads);
