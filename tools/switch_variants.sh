@@ -7,7 +7,7 @@
 #     walk->jump's transition policy and then its q_ab, on BASE_RUN's S_a and T_b and with
 #     BASE_RUN's jump->walk artefacts; then With TP and With TP + Q are evaluated (50
 #     episodes x seeds 0-2, printed). ~8-20 min.
-#     e.g. tools/switch_variants.sh disc_steps2 --transition runs/hurdle --set transition.discriminator.steps=2
+#     e.g. tools/switch_variants.sh disc_steps2 --transition runs/hurdle15 --set transition.discriminator.steps=2
 # Prints margins.csv (held-out hand-overs per switch margin). Run dir runs/switch_NAME;
 # rerunning resumes it. In the first form T_b is kept small (2000 rows), since no pi_ab is
 # trained from it, and every variant after the first (`plain`, run first) reuses
