@@ -126,8 +126,8 @@ TEST(LeadIn, RefusesWhatCannotLeadIn) {
               std::string::npos)
         << e.what();
   }
-  // An interval the walk never enters (no curb is ever behind it in a one-curb task
-  // with no room past the curb) is refused after kAttempts episodes, not looped on.
+  // An interval the walk never enters (the episode ends at x = 15, long before any curb
+  // is 100 m behind) is refused after kAttempts episodes, not looped on.
   LeadInEnv never(make_task("walker_jump", kJumpEnv),
                   walk_lead_in("{policy: " + walk + ", when: {curb_behind: [100, 200]}}"));
   std::vector<float> obs(never.spec().obs_dim);
