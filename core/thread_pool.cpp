@@ -25,7 +25,14 @@ ThreadPool::~ThreadPool() {
 }
 
 void ThreadPool::drain() {
-  for (int i = next_.fetch_add(1); i < n_; i = next_.fetch_add(1)) (*job_)(i, i + 1);
+  for (int i = next_.fetch_add(1); i < n_; i = next_.fetch_add(1)) {
+    try {
+      (*job_)(i, i + 1);
+    } catch (...) {
+      std::lock_guard<std::mutex> lock(mutex_);
+      if (!error_) error_ = std::current_exception();
+    }
+  }
 }
 
 void ThreadPool::parallel_for(int n, const std::function<void(int, int)>& fn) {
@@ -44,6 +51,12 @@ void ThreadPool::parallel_for(int n, const std::function<void(int, int)>& fn) {
   start_.notify_all();
   drain();
   while (busy_.load(std::memory_order_acquire) > 0) std::this_thread::yield();
+  std::exception_ptr error;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    std::swap(error, error_);
+  }
+  if (error) std::rethrow_exception(error);
 }
 
 void ThreadPool::work(long seen) {

@@ -6,6 +6,7 @@
 // a vector step is a few hundred microseconds, comparable to a futex wake-up.
 #include <atomic>
 #include <condition_variable>
+#include <exception>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -20,7 +21,9 @@ class ThreadPool {
   ThreadPool(const ThreadPool&) = delete;
   ThreadPool& operator=(const ThreadPool&) = delete;
   int size() const { return static_cast<int>(workers_.size()) + 1; }
-  // Calls fn(i, i + 1) for every i in [0, n) and waits for all of them.
+  // Calls fn(i, i + 1) for every i in [0, n) and waits for all of them. An exception
+  // reaches the caller: with workers, the first one thrown, once every other item has run
+  // (uncaught on a worker it would end the process).
   void parallel_for(int n, const std::function<void(int, int)>& fn);
 
  private:
@@ -35,6 +38,7 @@ class ThreadPool {
   std::atomic<int> busy_{0};        // workers still inside the current job
   std::atomic<long> generation_{0};
   bool stop_ = false;
+  std::exception_ptr error_;        // the current job's first exception (under mutex_)
 };
 
 // Threads to use for a "threads" setting: 0 means every core.

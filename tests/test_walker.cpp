@@ -1,8 +1,10 @@
 // The walker environment: shapes, determinism, exact state save/restore, reward terms.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cmath>
 
+#include "core/error.h"
 #include "core/rng.h"
 #include "core/vector_env.h"
 #include "environments/registry.h"
@@ -196,6 +198,29 @@ TEST(ThreadPool, EveryItemOnceEvenWhenJobsArriveBeforeWorkersStart) {
     });
     for (int i = 0; i < 37; ++i) ASSERT_EQ(hits[i], i < 5 ? 11 : 1) << "round " << round << " item " << i;
   }
+}
+
+// An item that throws on a worker thread reaches the caller as that exception (the
+// process would otherwise end); the other items still run, and the pool stays usable.
+TEST(ThreadPool, AWorkersExceptionIsRethrownToTheCaller) {
+  ThreadPool pool(2);
+  for (int round = 0; round < 200; ++round) {
+    std::vector<std::atomic<int>> hits(16);
+    try {
+      pool.parallel_for(16, [&](int b, int) {
+        if (b == 5 || b == 11) throw Error("item " + std::to_string(b));
+        hits[b] += 1;
+      });
+      FAIL() << "round " << round << ": no exception reached the caller";
+    } catch (const Error& e) {
+      const std::string what = e.what();
+      ASSERT_TRUE(what == "item 5" || what == "item 11") << what;
+    }
+    for (int i = 0; i < 16; ++i) ASSERT_EQ(hits[i].load(), i == 5 || i == 11 ? 0 : 1) << "round " << round;
+  }
+  std::atomic<int> sum{0};
+  pool.parallel_for(4, [&](int, int) { sum += 1; });
+  EXPECT_EQ(sum.load(), 4);
 }
 
 }  // namespace segue
