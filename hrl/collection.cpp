@@ -59,9 +59,15 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
 }
 
 Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, int count, uint64_t seed,
-                                      int max_episodes, const std::atomic<int>* stop) {
+                                      int max_episodes, const std::atomic<int>* stop, const StartStates* handovers) {
   const Transition& tr = r.meta.transitions().at(transition);
   const bool own_task = !tr.expert_task.empty();
+  if (tr.expert_after_handover) {
+    if (!handovers || handovers->size() == 0)
+      throw Error(r.file + ": transition " + r.transition_name(transition) +
+                  ": expert.after_handover needs S_a's states, and none were given");
+    max_episodes = handovers->size();  // restores are exact and pi_b deterministic: once each
+  }
   auto env = own_task ? reference_task_factory(tr.expert_task)() : r.make_env();
   const EnvSpec& spec = env->spec();
   Skill b = r.skills[tr.to];
@@ -72,13 +78,18 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
     b.obs_end = D;
   }
   std::vector<float> obs(spec.obs_dim), act(spec.act_dim), prev(D);
-  std::vector<double> f(spec.feature_names.size());
+  std::vector<double> f(spec.feature_names.size()), state;
   Demonstrations out, window;  // window: this episode's steps, added to out once kept
   out.obs_dim = window.obs_dim = D;
   out.act_dim = window.act_dim = spec.act_dim;
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {
     if (stop && stop->load()) return out;
-    env->reset(mix_seed(seed, e), obs.data());
+    if (tr.expert_after_handover) {
+      handovers->state(e, state);
+      env->restore_state(state, obs.data());
+    } else {
+      env->reset(mix_seed(seed, e), obs.data());
+    }
     window.clear();
     bool entered = false, past = false, done = false, succeeded = false;
     int successes = 0, at_entry = 0;  // the task's success count, now and on entering
@@ -95,6 +106,9 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
       StepResult sr = env->step(act.data(), obs.data());
       done = sr.done();
       successes = sr.info.success_count;
+      // A restored episode's count so far is first seen after a step; no success is won in
+      // the one step after pi_a hands over.
+      if (t == 0 && tr.expert_after_handover) at_entry = successes;
       succeeded |= entered && successes > at_entry;
       if (inside && !past) {
         window.obs.insert(window.obs.end(), prev.begin(), prev.end());
@@ -109,10 +123,11 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
       break;
     }
   }
-  if (out.size() < count)
+  if (out.size() < count && !(tr.expert_after_handover && out.size() > 0))
     throw Error(r.file + ": pi_b of transition " + r.transition_name(transition) + " gave only " +
                 std::to_string(out.size()) + " demonstration steps in " + std::to_string(max_episodes) +
-                " episodes (T_b: pi_b's steps inside its expert window, in episodes it runs alone" +
+                " episodes (T_b: pi_b's steps inside its expert window, in episodes it runs " +
+                (tr.expert_after_handover ? "from S_a's states" : "alone") +
                 (tr.expert_successful ? " and then succeeds)" : ")"));
   return out;
 }

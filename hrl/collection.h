@@ -8,8 +8,11 @@
 //   T_b: pi_b's own (s, a, s') inside its interval: episodes that pi_b runs from the start,
 //        recorded while the transition's `expert.when` holds (with `expert.successful`,
 //        only windows after which pi_b succeeds, so T_b may overshoot its count by part of
-//        a window). Observations are in pi_b's slice of the task observation.
+//        a window). Observations are in pi_b's slice of the task observation. With
+//        `expert.after_handover`, episodes start instead at S_a's states, one each, and
+//        T_b is as large as they give (at most `count`).
 // Both are stored as tensors in a .pt file (torch.load-able) that later stages read back.
+#include <algorithm>
 #include <atomic>
 #include <string>
 #include <vector>
@@ -26,6 +29,11 @@ struct StartStates {
   // Copies snapshot i into `out` (resized), ready for Env::restore_state.
   void state(int i, std::vector<double>& out) const {
     out.assign(states.begin() + size_t(i) * state_dim, states.begin() + size_t(i + 1) * state_dim);
+  }
+  // Keeps the first n states (all if there are fewer).
+  void keep_first(int n) {
+    n = std::max(0, std::min(n, size()));
+    states.resize(size_t(n) * state_dim), obs.resize(size_t(n) * obs_dim);
   }
 };
 
@@ -55,8 +63,10 @@ constexpr int kEmptyEpisodes = 1000;
 StartStates collect_start_states(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
                                  const std::vector<TransitionArtefacts>& trained = {},
                                  int max_episodes = kStartStateEpisodes, const std::atomic<int>* stop = nullptr);
+// `handovers`: S_a's training states, required with expert.after_handover.
 Demonstrations collect_demonstrations(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
-                                      int max_episodes = kDemonstrationEpisodes, const std::atomic<int>* stop = nullptr);
+                                      int max_episodes = kDemonstrationEpisodes, const std::atomic<int>* stop = nullptr,
+                                      const StartStates* handovers = nullptr);
 
 void save(const StartStates& s, const std::string& path);
 void save(const Demonstrations& d, const std::string& path);

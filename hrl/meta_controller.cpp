@@ -55,10 +55,12 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
       Section e = t.sub("expert");
       tr.expert_task = e.get<std::string>("task", "");
       tr.expert_successful = e.get<bool>("successful", false);
+      tr.expert_after_handover = e.get<bool>("after_handover", false);
       if (tr.expert_task.empty()) {
         if (e.has("when")) tr.expert_when = read_when(e, features);  // else the interval
       } else {
         if (e.has("when")) throw e.error("when", "applies to this task's features; with expert.task give expert.steps");
+        if (tr.expert_after_handover) throw e.error("after_handover", "S_a's states are this task's; not with expert.task");
         tr.expert_steps = e.require<int>("steps");
         if (tr.expert_steps <= 0) throw e.error("steps", "must be positive");
       }

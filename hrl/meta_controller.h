@@ -39,6 +39,11 @@ struct Transition {
   // the states pi_b expects are those it succeeds from. Matters when pi_b itself often
   // fails (stage 13's jump cleared 38%): matching all its states would match its failures too.
   bool expert_successful = false;
+  // Or record pi_b where it actually takes over: one episode from each of S_a's training
+  // states (not the held-out ones), pi_b in control from there (`expert: {after_handover:
+  // true}`). When pi_b was trained to take over from pi_a (a `lead_in`), its own start's
+  // states are not the ones it succeeds from in the task; matching them leads pi_ab away.
+  bool expert_after_handover = false;
   // |S_a| for this transition (`start_states: N`); 0 takes collect.start_states. A late
   // interval is reached only as often as every earlier hand-over succeeds, so a recipe
   // may ask for fewer states there rather than run tens of thousands of episodes.

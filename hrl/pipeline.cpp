@@ -39,13 +39,22 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
   }
   if (!exists(dir + "/demonstrations.pt")) {
     const Transition& tr = r.meta.transitions()[t];
-    if (tr.expert_task.empty())
+    if (tr.expert_after_handover)
+      spdlog::info("  collecting T_b: at most {} steps of pi_b in its interval, taking over at S_a's states",
+                   c.demonstrations);
+    else if (tr.expert_task.empty())
       spdlog::info("  collecting T_b: {} steps of pi_b in its own interval", c.demonstrations);
     else
       spdlog::info("  collecting T_b: {} steps of pi_b, its first {} of each episode on {}", c.demonstrations,
                    tr.expert_steps, tr.expert_task);
+    // After the hand-over: from S_a's states less those held out for the switch margin.
+    StartStates handovers;
+    if (tr.expert_after_handover) {
+      handovers = load_start_states(dir + "/start_states.pt");
+      handovers.keep_first(handovers.size() - r.pipeline.switching.validation_starts);
+    }
     Demonstrations d = collect_demonstrations(r, t, c.demonstrations, mix_seed(r.pipeline.seed, 2 * t + 1),
-                                              kDemonstrationEpisodes, stop);
+                                              kDemonstrationEpisodes, stop, &handovers);
     if (int sig = signal_of(stop)) return sig;
     save(d, dir + "/demonstrations.pt");
   }

@@ -55,6 +55,21 @@ TEST(Collection, StartStatesAreAtTheIntervalAndReplayPiA) {
 class CollectionFiles : public TempDirTest {
  protected:
   CollectionFiles() : TempDirTest("collect") {}
+  // Hurdle (walk->jump's T_b from the windows the jump succeeds from) with stage 13's 38%
+  // jump, and `expert_extra` (", key: value") added to walk->jump's expert.
+  CompositeRecipe hurdle_with_stage13_jump(const std::string& expert_extra) {
+    std::ifstream in(CompositeRecipe::default_file("hurdle"));
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string expert = "expert: {successful: true";
+    const std::string shipped = "jump: {policy: assets/policies/walker/walker_jump.pt}";
+    if (text.find(expert) == std::string::npos || text.find(shipped) == std::string::npos)
+      throw Error("hurdle.yaml no longer has '" + expert + "' and '" + shipped + "'");
+    text.insert(text.find(expert) + expert.size(), expert_extra);
+    text.replace(text.find(shipped), shipped.size(),
+                 "jump: {policy: assets/policies/walker/archive/walker_jump_stage13.pt}");
+    std::ofstream(path("hurdle.yaml")) << text;
+    return CompositeRecipe::load(path("hurdle.yaml"));
+  }
 };
 
 TEST_F(CollectionFiles, DemonstrationsArePiBsOwnStepsInItsWindow) {
@@ -218,17 +233,8 @@ TEST(Collection, DemonstrationsFromTheSkillsOwnTaskAreItsFirstSteps) {
 // walk -> jump the window is 3-4 m before the first curb and success is clearing it;
 // the expected T_b is rebuilt by replaying each episode of the jump by hand.
 TEST_F(CollectionFiles, SuccessfulDemonstrationsAreTheWindowsPiBSucceedsFrom) {
-  std::ifstream in(CompositeRecipe::default_file("hurdle"));
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  const std::string line = "{from: walk, to: jump, when: {curb_ahead: [3, 4]}";
-  ASSERT_NE(text.find(line), std::string::npos);
-  text.insert(text.find(line) + line.size(), ", expert: {successful: true}");
   // Stage 13's jump (38%), so that some windows are dropped whatever the shipped jump's rate.
-  const std::string shipped = "jump: {policy: assets/policies/walker/walker_jump.pt}";
-  ASSERT_NE(text.find(shipped), std::string::npos);
-  text.replace(text.find(shipped), shipped.size(), "jump: {policy: assets/policies/walker/archive/walker_jump_stage13.pt}");
-  std::ofstream(path("hurdle.yaml")) << text;
-  CompositeRecipe r = CompositeRecipe::load(path("hurdle.yaml"));
+  CompositeRecipe r = hurdle_with_stage13_jump("");
   const Transition& tr = r.meta.transitions()[0];
   ASSERT_TRUE(tr.expert_successful);
   const int count = 300;
@@ -295,6 +301,73 @@ TEST_F(CollectionFiles, ExpertWindowsAreCheckedAtLoadAndAfterAThousandEmptyEpiso
     FAIL() << "collected demonstrations outside any window";
   } catch (const Error& e) {
     EXPECT_NE(std::string(e.what()).find("transition walk-crawl gave only 0 demonstration steps in 1000 episodes"),
+              std::string::npos) << e.what();
+  }
+}
+
+// expert.after_handover: T_b is pi_b's window from each S_a state it is given, once each;
+// with expert.successful only those after which pi_b clears the curb it took over for
+// (also at later curbs, where the episode's count is already above 0). Rebuilt by hand:
+// restore each state, run the jump while the interval holds, then on to its next success.
+TEST_F(CollectionFiles, DemonstrationsAfterTheHandOverStartAtSaAndKeepTheWindowsPiBSucceedsFrom) {
+  CompositeRecipe r = hurdle_with_stage13_jump(", after_handover: true");
+  const Transition& tr = r.meta.transitions()[0];
+  ASSERT_TRUE(tr.expert_after_handover && tr.expert_successful);
+  StartStates s = collect_start_states(r, 0, 24, 4);
+  s.keep_first(20);  // as the pipeline drops the held-out states
+  ASSERT_EQ(s.size(), 20);
+  ASSERT_EQ(s.obs.size(), size_t(20 * s.obs_dim));
+  Demonstrations d = collect_demonstrations(r, 0, 100000, 9, kDemonstrationEpisodes, nullptr, &s);
+
+  auto env = r.make_env();
+  const Skill& jump = r.skills[tr.to];
+  std::vector<float> obs(env->spec().obs_dim), act(env->spec().act_dim), want;
+  std::vector<double> f(env->spec().feature_names.size()), state;
+  int kept = 0, dropped = 0, later_curbs = 0;
+  for (int i = 0; i < s.size(); ++i) {
+    s.state(i, state);
+    env->restore_state(state, obs.data());
+    std::vector<float> window;
+    int before = -1;  // the episode's success count as the jump takes over
+    bool past = false, cleared = false;
+    for (;;) {
+      env->features(f.data());
+      past |= !MetaController::holds(tr.when, f.data());
+      if (past && cleared) break;
+      if (!past) window.insert(window.end(), obs.begin() + jump.obs_begin, obs.begin() + jump.obs_end);
+      jump.policy.act(obs.data() + jump.obs_begin, 1, act.data());
+      StepResult sr = env->step(act.data(), obs.data());
+      if (before < 0) before = sr.info.success_count, later_curbs += before > 0;
+      cleared |= sr.info.success_count > before;
+      if (sr.done()) break;
+    }
+    if (cleared) ++kept, want.insert(want.end(), window.begin(), window.end());
+    else ++dropped;
+  }
+  EXPECT_GT(kept, 0);
+  EXPECT_GT(dropped, 0);
+  EXPECT_GT(later_curbs, 0);
+  EXPECT_EQ(d.obs, want);
+
+  // Without S_a's states, or with the skill's own task, it is refused.
+  try {
+    collect_demonstrations(r, 0, 100, 9);
+    ADD_FAILURE() << "collected after a hand-over without S_a";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("transition walk-jump: expert.after_handover needs S_a's states"),
+              std::string::npos) << e.what();
+  }
+  std::ifstream in(CompositeRecipe::default_file("obstacle_course"));
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string own = "expert: {task: walker_crawl, steps: 150";
+  ASSERT_NE(text.find(own), std::string::npos);
+  text.insert(text.find(own) + own.size(), ", after_handover: true");
+  std::ofstream(path("course.yaml")) << text;
+  try {
+    CompositeRecipe::load(path("course.yaml"));
+    ADD_FAILURE() << "after_handover with expert.task";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'transitions.1.expert.after_handover': S_a's states are this task's"),
               std::string::npos) << e.what();
   }
 }

@@ -8,6 +8,7 @@
 //               the interval a hand-over succeeds most, i.e. what q_ab could gain over With TP
 // Build: cmake --build build --target probe_subtask_success
 // usage: build/probe_subtask_success RECIPE RUN_DIR TRANSITION_INDEX from-sa|in-context|switch-at N
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <string>
@@ -48,6 +49,9 @@ int main(int argc, char** argv) {
     std::vector<double> state, features(env->spec().feature_names.size());
     std::vector<int> at_k, tried_k;  // by k / 10
     int end_ok = 0, falls = 0, any_ok = 0, rescued = 0;
+    // k = 0 by where the start is, per 10 m of x (snapshot[2], the walker's root x): on
+    // Hurdle, the curb the hand-over is for.
+    std::vector<int> k0_ok(16, 0), k0_tried(16, 0);
     for (int i = 0; i < n; ++i) {
       bool some = false, last = false;  // some k succeeded; the last k before the end or fall did
       for (int k = 0;; k += 10) {
@@ -65,6 +69,10 @@ int main(int argc, char** argv) {
         const bool success = run_subtask(*env, c, tr.to, obs.data(), 2, 5000);
         some = some || success;
         if (left) { end_ok += success; break; }  // the forced switch: With TP
+        if (k == 0) {
+          const int at = std::min(15, std::max(0, int(state[2] / 10)));
+          ++k0_tried[at], k0_ok[at] += success;
+        }
         if (tried_k.size() <= size_t(k / 10)) tried_k.push_back(0), at_k.push_back(0);
         ++tried_k[k / 10], at_k[k / 10] += success, last = success;
       }
@@ -74,6 +82,8 @@ int main(int argc, char** argv) {
                 "before it succeeds in %d\n", any_ok, n, falls, rescued);
     for (size_t j = 0; j < tried_k.size(); ++j) std::printf("switch at %3zu: %d of %d\n", 10 * j, at_k[j], tried_k[j]);
     std::printf("interval end (With TP): %d of %d; %d fell before it\n", end_ok, n - falls, falls);
+    for (int j = 0; j < 16; ++j)
+      if (k0_tried[j]) std::printf("switch at 0, start x in [%d, %d) m: %d of %d\n", 10 * j, 10 * j + 10, k0_ok[j], k0_tried[j]);
     return 0;
   } else {
     for (int e = 0; e < n; ++e) {
