@@ -8,6 +8,10 @@
 #     BASE_RUN's jump->walk artefacts; then With TP and With TP + Q are evaluated (50
 #     episodes x seeds 0-2, printed). ~8-20 min.
 #     e.g. tools/switch_variants.sh disc_steps2 --transition runs/hurdle15 --set transition.discriminator.steps=2
+#   tools/switch_variants.sh NAME --transition BASE_RUN --new-tb [--set key=value ...]
+#     as above, but walk->jump's T_b is collected afresh, for settings that change it; e.g.
+#     tools/switch_variants.sh tbhandover --transition runs/hurdle16L --new-tb \
+#       --set transitions.0.expert.after_handover=true
 # Prints margins.csv (held-out hand-overs per switch margin). Run dir runs/switch_NAME;
 # rerunning resumes it. In the first form T_b is kept small (2000 rows), since no pi_ab is
 # trained from it, and every variant after the first (`plain`, run first) reuses
@@ -18,10 +22,13 @@ cd "$(dirname "$0")/.."
 name=$1; shift
 base=
 if [ "${1:-}" = --transition ]; then base=$2; shift 2; fi
+new_tb=
+if [ "${1:-}" = --new-tb ]; then new_tb=1; shift; fi
 run=runs/switch_$name
 mkdir -p "$run/walk-jump" "$run/jump-walk"
 if [ -n "$base" ]; then
-  cp -n "$base"/walk-jump/{start_states.pt,demonstrations.pt} "$run/walk-jump/"
+  cp -n "$base"/walk-jump/start_states.pt "$run/walk-jump/"
+  [ -n "$new_tb" ] || cp -n "$base"/walk-jump/demonstrations.pt "$run/walk-jump/"
   cp -n "$base"/jump-walk/{start_states.pt,demonstrations.pt,policy.pt,q.pt} "$run/jump-walk/"
   overrides=()
 else
