@@ -40,7 +40,7 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
   if (!exists(dir + "/demonstrations.pt")) {
     const Transition& tr = r.meta.transitions()[t];
     if (tr.expert_after_handover)
-      spdlog::info("  collecting T_b: at most {} steps of pi_b in its interval, taking over at S_a's states",
+      spdlog::info("  collecting T_b: at most {} steps of pi_b in its window, taking over at S_a's states",
                    c.demonstrations);
     else if (tr.expert_task.empty())
       spdlog::info("  collecting T_b: {} steps of pi_b in its own interval", c.demonstrations);

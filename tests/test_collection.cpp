@@ -20,6 +20,17 @@ CompositeRecipe patrol() {
   return CompositeRecipe::load(CompositeRecipe::default_file("patrol"), {"env.push_prob=0"});
 }
 
+// f() must throw a segue::Error whose message contains `message`.
+template <class F>
+void expect_error(F f, const std::string& message) {
+  try {
+    f();
+    ADD_FAILURE() << "no error; expected one with: " << message;
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+  }
+}
+
 }  // namespace
 
 TEST(Collection, StartStatesAreAtTheIntervalAndReplayPiA) {
@@ -289,20 +300,10 @@ TEST_F(CollectionFiles, ExpertWindowsAreCheckedAtLoadAndAfterAThousandEmptyEpiso
     const std::string when = "when: {ceiling_ahead: [2, 3]}";
     bad.insert(bad.find(when) + when.size(), ", expert: {task: " + task + ", steps: 9}");
     std::ofstream(path("bad.yaml")) << bad;
-    try {
-      CompositeRecipe::load(path("bad.yaml"));
-      ADD_FAILURE() << task;
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
-    }
+    expect_error([&] { CompositeRecipe::load(path("bad.yaml")); }, message);
   }
-  try {
-    collect_demonstrations(r, 1, 100, 5);
-    FAIL() << "collected demonstrations outside any window";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("transition walk-crawl gave only 0 demonstration steps in 1000 episodes"),
-              std::string::npos) << e.what();
-  }
+  expect_error([&] { collect_demonstrations(r, 1, 100, 5); },
+               "transition walk-crawl gave only 0 demonstration steps in 1000 episodes");
 }
 
 // expert.after_handover: T_b is pi_b's window from each S_a state it is given, once each;
@@ -350,26 +351,16 @@ TEST_F(CollectionFiles, DemonstrationsAfterTheHandOverStartAtSaAndKeepTheWindows
   EXPECT_EQ(d.obs, want);
 
   // Without S_a's states, or with the skill's own task, it is refused.
-  try {
-    collect_demonstrations(r, 0, 100, 9);
-    ADD_FAILURE() << "collected after a hand-over without S_a";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("transition walk-jump: expert.after_handover needs S_a's states"),
-              std::string::npos) << e.what();
-  }
+  expect_error([&] { collect_demonstrations(r, 0, 100, 9); },
+               "transition walk-jump: expert.after_handover needs S_a's states");
   std::ifstream in(CompositeRecipe::default_file("obstacle_course"));
   std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string own = "expert: {task: walker_crawl, steps: 150";
   ASSERT_NE(text.find(own), std::string::npos);
   text.insert(text.find(own) + own.size(), ", after_handover: true");
   std::ofstream(path("course.yaml")) << text;
-  try {
-    CompositeRecipe::load(path("course.yaml"));
-    ADD_FAILURE() << "after_handover with expert.task";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("key 'transitions.1.expert.after_handover': S_a's states are this task's"),
-              std::string::npos) << e.what();
-  }
+  expect_error([&] { CompositeRecipe::load(path("course.yaml")); },
+               "key 'transitions.1.expert.after_handover': S_a's states are this task's");
 }
 
 }  // namespace segue
