@@ -69,6 +69,7 @@ SwitchConfig SwitchConfig::read(const Section& s, int obs_dim) {
   c.validation_starts = s.get("validation_starts", c.validation_starts);
   c.margins = s.get("margins", c.margins);
   if (s.has("fourier")) c.features = ObsFeatures::read(s.sub("fourier"), obs_dim);  // only when given
+  if (!(c.net.gamma > 0 && c.net.gamma <= 1)) throw s.error("gamma", "must be in (0, 1]");
   if (c.validation_starts < 0) throw s.error("validation_starts", "must be >= 0");
   if (c.margins.empty()) throw s.error("margins", "lists no margin");
   for (double m : c.margins)
