@@ -3,6 +3,8 @@
 // from the run seed, so a run is a pure function of its seed, whatever the thread count.
 #include <cstdint>
 #include <random>
+#include <sstream>
+#include <string>
 
 namespace segue {
 
@@ -28,6 +30,16 @@ class Rng {
     return std::uniform_int_distribution<int>(lo, hi_inclusive)(engine_);
   }
   std::mt19937_64& engine() { return engine_; }
+  // The stream's position as text (the standard library's format), for checkpoints.
+  std::string state() const {
+    std::ostringstream s;
+    s << engine_ << ' ' << normal_;
+    return s.str();
+  }
+  void set_state(const std::string& text) {
+    std::istringstream s(text);
+    s >> engine_ >> normal_;
+  }
 
  private:
   std::mt19937_64 engine_;

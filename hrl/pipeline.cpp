@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <functional>
 #include <sstream>
@@ -150,25 +151,32 @@ int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const Pip
   return stop;
 }
 
-// Returns the signal number when stopped (the stage has no checkpoint: it restarts), else 0.
+// Reports and checkpoints every tenth of the attempts (at most 100), so that a stopped
+// stage resumes where it was; the checkpoint goes once q.pt is written. Returns the
+// signal number when stopped, else 0.
 int train_switch(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
                  const std::atomic<int>* stop) {
   const SwitchConfig& cfg = r.pipeline.switching;
   SwitchTrainer trainer(cfg, r, t, load_start_states(dir + "/start_states.pt"), Policy::load(dir + "/policy.pt"),
                         load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false),
                         mix_seed(r.pipeline.seed, 200 + t));
-  MetricsCsv csv(dir + "/switch.csv", {"attempts", "epsilon", "subtask_success", "switch_step", "loss", "env_steps", "wall_seconds"}, 0);
-  const int chunk = 100;
-  auto t0 = std::chrono::steady_clock::now();
-  SwitchStats s;
+  const std::string ckpt = dir + "/switch_checkpoint.pt";
+  const int chunk = std::clamp(cfg.attempts / 10, 1, 100);
+  if (exists(ckpt)) {
+    trainer.load(ckpt);
+    spdlog::info("  resuming from attempt {}", trainer.attempts_done());
+  }
+  MetricsCsv csv(dir + "/switch.csv", {"attempts", "epsilon", "subtask_success", "switch_step", "loss", "env_steps", "wall_seconds"},
+                 (trainer.attempts_done() + chunk - 1) / chunk);
   while (trainer.attempts_done() < cfg.attempts) {
-    if (int sig = signal_of(stop)) return sig;
-    s = trainer.run(std::min(chunk, cfg.attempts - trainer.attempts_done()));
-    double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    SwitchStats s = trainer.run(std::min(chunk, cfg.attempts - trainer.attempts_done()));
     csv.write({double(trainer.attempts_done()), s.epsilon, s.success_rate, s.switch_step, s.loss,
-               double(trainer.env_steps()), secs});
+               double(trainer.env_steps()), trainer.wall_seconds()});
     spdlog::info("  q_ab: {}/{} attempts, epsilon {:.2f}, pi_b succeeded in {:.0f}%, switch at step {:.1f}",
                  trainer.attempts_done(), cfg.attempts, s.epsilon, 100 * s.success_rate, s.switch_step);
+    trainer.save(ckpt);
+    int sig = signal_of(stop);
+    if (sig && trainer.attempts_done() < cfg.attempts) return sig;
   }
   double margin = 0.0;
   if (cfg.validation_starts > 0) {
@@ -184,9 +192,9 @@ int train_switch(const CompositeRecipe& r, int t, const std::string& run, const 
     spdlog::info("  q_ab: switches where Q(switch) > Q(stay) + {:g}", margin);
   }
   trainer.q_function(margin).export_torchscript(dir + "/q.pt");
-  double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  fs::remove(ckpt);
   spdlog::info("  q_ab: {} attempts, {} environment steps in {}", cfg.attempts, trainer.env_steps(),
-               format_duration(secs));
+               format_duration(trainer.wall_seconds()));
   return 0;
 }
 
@@ -247,7 +255,7 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
       return 0;
     }
     int stop = train();
-    if (stop) spdlog::warn("interrupted: rerun the same command to resume (from the last checkpoint where the stage has one)");
+    if (stop) spdlog::warn("interrupted: rerun the same command to resume from the stage's last checkpoint");
     return stop;
   };
   auto tdir = [&](int t) { return run + "/" + recipe.transition_name(t); };

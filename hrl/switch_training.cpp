@@ -1,8 +1,14 @@
 #include "hrl/switch_training.h"
 
+#include <ATen/CPUGeneratorImpl.h>
+
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
+#include <mutex>
+
+#include "core/run_dir.h"
 
 namespace segue {
 
@@ -156,6 +162,7 @@ double SwitchTrainer::update() {
 }
 
 SwitchStats SwitchTrainer::run(int n) {
+  const auto t0 = std::chrono::steady_clock::now();
   SwitchStats s;
   int updates = 0;
   for (int k = 0; k < n; ++k) {
@@ -174,7 +181,95 @@ SwitchStats SwitchTrainer::run(int n) {
   }
   if (s.attempts) s.success_rate /= s.attempts, s.switch_step /= s.attempts;
   if (updates) s.loss /= updates;
+  wall_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return s;
+}
+
+namespace {
+
+torch::Tensor text_tensor(const std::string& s) { return torch::tensor(std::vector<int64_t>(s.begin(), s.end())); }
+
+std::string tensor_text(const torch::Tensor& t) {
+  auto c = t.to(torch::kLong).contiguous();
+  return std::string(c.data_ptr<int64_t>(), c.data_ptr<int64_t>() + c.numel());
+}
+
+}  // namespace
+
+void SwitchTrainer::save(const std::string& path) const {
+  torch::serialize::OutputArchive ar, q, target, opt;
+  q_->save(q);
+  target_->save(target);
+  opt_->save(opt);
+  ar.write("q", q);
+  ar.write("target", target);
+  ar.write("optimizer", opt);
+  const int64_t rows = std::min<int64_t>(stored_, cfg_.replay), I = q_ab_.in_dim();
+  auto blob = [](const auto& v, std::vector<int64_t> shape, torch::Dtype type) {
+    return torch::from_blob(const_cast<void*>(static_cast<const void*>(v.data())), shape, type);
+  };
+  ar.write("replay_obs", blob(obs_, {rows, I}, torch::kFloat32));
+  ar.write("replay_next_obs", blob(next_obs_, {rows, I}, torch::kFloat32));
+  ar.write("replay_action", blob(action_, {rows}, torch::kLong));
+  ar.write("replay_reward", blob(reward_, {rows}, torch::kFloat32));
+  ar.write("replay_done", blob(done_, {rows}, torch::kFloat32));
+  ar.write("counters", torch::tensor(std::vector<int64_t>{stored_, attempts_, updates_, env_steps_,
+                                                          int64_t(wall_seconds_ * 1000)}));
+  ar.write("rng", text_tensor(rng_.state()));
+  at::Generator gen = at::detail::getDefaultCPUGenerator();
+  {
+    std::lock_guard<std::mutex> lock(gen.mutex());
+    ar.write("torch_rng", gen.get_state());
+  }
+  std::ostringstream bytes;
+  ar.save_to(bytes);
+  write_file_atomic(path, bytes.str());
+}
+
+void SwitchTrainer::load(const std::string& path) {
+  torch::serialize::InputArchive ar, q, target, opt;
+  torch::Tensor obs, next, action, reward, done, counters, rng, torch_rng;
+  try {
+    ar.load_from(path);
+    ar.read("replay_obs", obs);
+    if (obs.dim() != 2 || obs.size(1) != q_ab_.in_dim())
+      throw Error(path + ": the checkpoint's q_ab input width differs from the recipe's (" +
+                  std::to_string(q_ab_.in_dim()) + ")");
+    ar.read("q", q);
+    ar.read("target", target);
+    ar.read("optimizer", opt);
+    q_->load(q);
+    target_->load(target);
+    opt_->load(opt);
+    ar.read("replay_next_obs", next);
+    ar.read("replay_action", action);
+    ar.read("replay_reward", reward);
+    ar.read("replay_done", done);
+    ar.read("counters", counters);
+    ar.read("rng", rng);
+    ar.read("torch_rng", torch_rng);
+  } catch (const c10::Error&) {
+    throw Error(path + ": not a switch-training checkpoint for this recipe's q_ab");
+  }
+  auto floats = [](const torch::Tensor& t) {
+    auto c = t.contiguous();
+    return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
+  };
+  obs_ = floats(obs), next_obs_ = floats(next), reward_ = floats(reward), done_ = floats(done);
+  auto a = action.contiguous();
+  action_.assign(a.data_ptr<int64_t>(), a.data_ptr<int64_t>() + a.numel());
+  stored_ = counters[0].item<int64_t>();
+  attempts_ = int(counters[1].item<int64_t>());
+  updates_ = int(counters[2].item<int64_t>());
+  env_steps_ = counters[3].item<int64_t>();
+  wall_seconds_ = counters[4].item<int64_t>() / 1000.0;
+  rng_.set_state(tensor_text(rng));
+  at::Generator gen = at::detail::getDefaultCPUGenerator();
+  {
+    std::lock_guard<std::mutex> lock(gen.mutex());
+    gen.set_state(torch_rng);
+  }
+  q_ab_ = q_function();
 }
 
 Policy SwitchTrainer::q_function(double margin) const {

@@ -58,6 +58,14 @@ class SwitchTrainer {
   // Runs `n` attempts (with their updates) and reports on them.
   SwitchStats run(int n);
   int attempts_done() const { return attempts_; }
+  // Seconds spent in run() so far, over resumes.
+  double wall_seconds() const { return wall_seconds_; }
+  // Everything later attempts depend on: q_ab, its target and optimiser, the replay
+  // buffer, the counters and both random streams (ours and LibTorch's, which draws the
+  // minibatches). A trainer built as this one was and loaded from it continues exactly as
+  // this one would. Written atomically.
+  void save(const std::string& path) const;
+  void load(const std::string& path);
   // Environment steps so far: pi_ab's in the interval and pi_b's subtasks after switches.
   int64_t env_steps() const { return env_steps_; }
   // q_ab as a function of the task observation: forward(obs) -> [Q(stay), Q(switch)],
@@ -103,6 +111,7 @@ class SwitchTrainer {
   int attempts_ = 0, updates_ = 0, interval_length_ = 1;
   int train_starts_ = 0;  // S_a's first train_starts_ states train; the rest are held out
   int64_t env_steps_ = 0;
+  double wall_seconds_ = 0;
   std::vector<float> full_, next_full_, scratch_, qvals_;
   std::vector<double> features_, state_;
 };

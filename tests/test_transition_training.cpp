@@ -209,6 +209,44 @@ TEST_F(TransitionTraining, SwitchQNetworkExportsAsAPolicy) {
   for (int i = 0; i < 16; ++i) EXPECT_NEAR(a[i], c[i], 1e-5);
 }
 
+// A switch stage stopped and resumed from its checkpoint trains exactly the q_ab an
+// unbroken one does: same attempts, same minibatches, same weights.
+TEST_F(TransitionTraining, SwitchTrainingResumesExactlyFromItsCheckpoint) {
+  CompositeRecipe r = tiny();
+  const Skill& b = r.skills[r.meta.transitions()[0].to];
+  StartStates starts = collect_start_states(r, 0, 6, 1);
+  auto make = [&] { return std::make_unique<SwitchTrainer>(r.pipeline.switching, r, 0, starts, b.policy,
+                                                           std::vector<TransitionArtefacts>{}, 4); };
+  auto whole = make();
+  whole->run(12);
+  whole->run(12);
+  auto first = make();
+  ASSERT_GT(first->run(12).loss, 0.0);  // updates ran before the checkpoint (warmup 16 rows)
+  first->save(path("switch_checkpoint.pt"));
+  first.reset();
+  torch::rand({7});  // LibTorch's stream moves on in between, as other stages move it
+  auto resumed = make();
+  resumed->load(path("switch_checkpoint.pt"));
+  EXPECT_EQ(resumed->attempts_done(), 12);
+  resumed->run(12);
+  EXPECT_EQ(resumed->attempts_done(), whole->attempts_done());
+  EXPECT_EQ(resumed->env_steps(), whole->env_steps());
+  std::vector<float> want = whole->q_function().mlp().parameters(), got = resumed->q_function().mlp().parameters();
+  ASSERT_EQ(got.size(), want.size());
+  for (size_t i = 0; i < want.size(); ++i) ASSERT_EQ(got[i], want[i]) << "parameter " << i;
+  // Another q_ab's checkpoint (other input width) is refused, naming the file.
+  CompositeRecipe wide = tiny({"switch.fourier={inputs: [0], periods: [1]}"});
+  SwitchTrainer other(wide.pipeline.switching, wide, 0, starts, b.policy, {}, 4);
+  try {
+    other.load(path("switch_checkpoint.pt"));
+    ADD_FAILURE() << "a checkpoint of another width was loaded";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("switch_checkpoint.pt: the checkpoint's q_ab input width differs"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // switch.fourier: q_ab reads periodic features of chosen observations after its normalised
 // input, as a policy does; the exported q_ab computes exactly that input (by hand here).
 TEST_F(TransitionTraining, SwitchQNetworkReadsPeriodicFeatures) {
@@ -515,16 +553,36 @@ TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
   EXPECT_EQ(run_pipeline(r, o), 15);
   EXPECT_TRUE(fs::exists(t + "transition_checkpoint.pt"));
   EXPECT_FALSE(fs::exists(t + "policy.pt"));
+  // Each rerun while stopped goes one iteration on; the one that finishes pi_ab goes on
+  // to the switch stage, which checkpoints after its first report (a tenth of the attempts).
+  for (int run = 0; run < 10 && !fs::exists(t + "policy.pt"); ++run) EXPECT_EQ(run_pipeline(r, o), 15);
+  ASSERT_TRUE(fs::exists(t + "policy.pt"));
+  EXPECT_TRUE(fs::exists(t + "switch_checkpoint.pt"));
+  EXPECT_FALSE(fs::exists(t + "q.pt"));
+  auto lines_of = [](const std::string& file) {
+    std::ifstream in(file);
+    int n = 0;
+    for (std::string line; std::getline(in, line);) ++n;
+    return n;
+  };
+  EXPECT_EQ(lines_of(t + "switch.csv"), 1 + 1);
+  // The stage resumes from the checkpoint it finds: one written after 20 attempts leaves
+  // 4 to run (2 reports after the stopped run's one).
+  {
+    SwitchTrainer later(r.pipeline.switching, r, 0, load_start_states(t + "start_states.pt"),
+                        Policy::load(t + "policy.pt"), {}, 4);
+    later.run(20);
+    later.save(t + "switch_checkpoint.pt");
+  }
   // Resumed: every stage finishes, each iteration logged once.
   stop = 0;
   EXPECT_EQ(run_pipeline(r, o), 0);
   for (const char* f : {"start_states.pt", "demonstrations.pt", "policy.pt", "q.pt", "lee.pt", "transition.csv",
                         "switch.csv", "lee.csv", "actions.csv"})
     EXPECT_TRUE(fs::exists(t + f)) << f;
-  std::ifstream csv(t + "transition.csv");
-  int lines = 0;
-  for (std::string line; std::getline(csv, line);) ++lines;
-  EXPECT_EQ(lines, 1 + 4);  // header + 2048 / (4 x 128) iterations
+  EXPECT_EQ(lines_of(t + "transition.csv"), 1 + 4);  // header + 2048 / (4 x 128) iterations
+  EXPECT_EQ(lines_of(t + "switch.csv"), 1 + 1 + 2);
+  EXPECT_FALSE(fs::exists(t + "switch_checkpoint.pt")) << "kept after q.pt was written";
   std::ifstream json(path("run/patrol.json"));
   std::string text((std::istreambuf_iterator<char>(json)), {});
   for (const char* m : {"\"without-tp\"", "\"tp\"", "\"tp+q\"", "\"lee\""}) EXPECT_NE(text.find(m), std::string::npos) << m;
