@@ -146,6 +146,19 @@ LeeTrainer::Stats LeeTrainer::iterate() {
   return out;
 }
 
+namespace {
+
+torch::Tensor rows_of(const std::vector<float>& v, int64_t width) {
+  return torch::tensor(v).reshape({-1, width});
+}
+
+std::vector<float> floats_of(const torch::Tensor& t) {
+  auto c = t.to(torch::kFloat32).contiguous();
+  return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
+}
+
+}  // namespace
+
 void LeeTrainer::save(const std::string& path, const std::string& note) const {
   ppo_.save(path, note, [this](torch::serialize::OutputArchive& ar) {
     torch::serialize::OutputArchive p, o;
@@ -153,16 +166,29 @@ void LeeTrainer::save(const std::string& path, const std::string& note) const {
     opt_->save(o);
     ar.write("proximity_predictor", p);
     ar.write("proximity_optimizer", o);
+    ar.write("proximity_positive", rows_of(pos_, obs_dim_));
+    ar.write("proximity_positive_label", rows_of(pos_label_, 1));
+    ar.write("proximity_negative", rows_of(neg_, obs_dim_));
+    ar.write("proximity_seen", torch::tensor(std::vector<int64_t>{pos_n_, neg_n_}));
   });
 }
 
 void LeeTrainer::load(const std::string& path) {
-  ppo_.load(path, [this](torch::serialize::InputArchive& ar) {
+  ppo_.load(path, [this, &path](torch::serialize::InputArchive& ar) {
     torch::serialize::InputArchive p, o;
     ar.read("proximity_predictor", p);
     ar.read("proximity_optimizer", o);
     p_->load(p);
     opt_->load(o);
+    torch::Tensor seen, pos, label, neg;
+    if (!ar.try_read("proximity_seen", seen)) return;  // an older checkpoint
+    ar.read("proximity_positive", pos);
+    ar.read("proximity_positive_label", label);
+    ar.read("proximity_negative", neg);
+    if (pos.size(1) != obs_dim_ || neg.size(1) != obs_dim_)
+      throw Error(path + ": the proximity predictor's states have another width than pi_b's observation");
+    pos_ = floats_of(pos), pos_label_ = floats_of(label), neg_ = floats_of(neg);
+    pos_n_ = seen[0].item<int64_t>(), neg_n_ = seen[1].item<int64_t>();
   });
 }
 

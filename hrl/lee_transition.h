@@ -61,8 +61,13 @@ class LeeTrainer {
   Stats iterate();
   Policy policy() const { return ppo_.policy(); }
   const PPO& ppo() const { return ppo_; }
+  // The checkpoint holds P_b, its optimiser and its labelled states too, so a resumed
+  // stage fits P_b on all it had seen (older checkpoints without them: T_b and new episodes).
   void save(const std::string& path, const std::string& note) const;
   void load(const std::string& path);
+  // Labelled states seen so far (positive: T_b's and successful episodes'), ring overwrites included.
+  int64_t positives_seen() const { return pos_n_; }
+  int64_t negatives_seen() const { return neg_n_; }
 
  private:
   void reward(RolloutBuffer& buf);  // PPO's reward hook

@@ -493,6 +493,32 @@ TEST_F(TransitionTraining, SubtaskLookaheadEndsAtTheTasksOwnEvents) {
   EXPECT_GT(reached[3], 0) << "no episode got through a whole walk: lookahead 2 and 3 were not checked";
 }
 
+// A resumed Lee stage keeps the proximity predictor's labelled states (T_b's and every
+// finished episode's), not only its weights.
+TEST_F(TransitionTraining, LeeCheckpointKeepsThePredictorsLabelledStates) {
+  CompositeRecipe r = tiny();
+  const Skill& b = r.skills[r.meta.transitions()[0].to];
+  StartStates starts = collect_start_states(r, 0, 6, 1);
+  Demonstrations expert = collect_demonstrations(r, 0, 300, 2);
+  auto envs = [&] {
+    return std::make_unique<VectorEnv>([&] { return std::make_unique<LeeTransitionEnv>(r, 0, starts, 500); },
+                                       r.pipeline.transition.ppo.num_envs, 1);
+  };
+  auto first_envs = envs();
+  LeeTrainer first(r.pipeline.transition, r.pipeline.lee, *first_envs, expert, b.policy, 5);
+  EXPECT_EQ(first.positives_seen(), expert.size());
+  EXPECT_EQ(first.negatives_seen(), 0);
+  first.iterate(), first.iterate();
+  ASSERT_GT(first.positives_seen() + first.negatives_seen(), expert.size()) << "no episode was labelled";
+  first.save(path("lee_checkpoint.pt"), "test");
+  auto again_envs = envs();
+  LeeTrainer again(r.pipeline.transition, r.pipeline.lee, *again_envs, expert, b.policy, 5);
+  again.load(path("lee_checkpoint.pt"));
+  EXPECT_EQ(again.positives_seen(), first.positives_seen());
+  EXPECT_EQ(again.negatives_seen(), first.negatives_seen());
+  EXPECT_EQ(again.ppo().iteration(), 2);
+}
+
 TEST_F(TransitionTraining, LeeEpisodesEndAtTheTerminationOutputWithPiBsOutcome) {
   CompositeRecipe r = tiny();
   StartStates starts = collect_start_states(r, 0, 4, 1);
