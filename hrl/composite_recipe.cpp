@@ -90,6 +90,8 @@ std::vector<TransitionArtefacts> load_transition_artefacts(const CompositeRecipe
       Policy q = Policy::load(folder + "q.pt");
       EnvSpec qs = r.spec;
       qs.act_dim = 2;
+      const int with_features = qs.obs_dim + int(qs.feature_names.size());  // switch.interval_features
+      if (q.obs_dim() == with_features) qs.obs_dim = with_features;
       q.check_fits(qs, folder + "q.pt");
       out[t].q = q;
     }

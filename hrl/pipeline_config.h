@@ -82,6 +82,12 @@ struct SwitchConfig {
   // `fourier:` periodic features of q_ab's inputs, as a policy's (algorithms/obs_features.h):
   // whether a hand-over succeeds can hinge on where in pi_b's stride an obstacle falls.
   ObsFeatures features;
+  // `interval_features: true`: q_ab also reads the task's features (env.h: what transition
+  // intervals are written in, e.g. Patrol's steps since the turn), after the observation.
+  // The paper's q_ab reads the state only; where the interval's end is not visible in the
+  // state (Patrol's walker stands still through walk->balance's 100 steps), q_ab cannot
+  // tell how soon the forced switch comes.
+  bool interval_features = false;
 
   // obs_dim: the composite task's observation width (the features' inputs index it).
   static SwitchConfig read(const Section& s, int obs_dim);

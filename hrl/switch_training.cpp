@@ -41,13 +41,13 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
     throw Error("switch training: validation_starts (" + std::to_string(cfg_.validation_starts) +
                 ") leaves none of S_a's " + std::to_string(starts_.size()) + " states to train on");
   const EnvSpec& spec = env_->spec();
-  const int D = spec.obs_dim;
-  full_.resize(D), next_full_.resize(D), scratch_.resize(D), qvals_.resize(2);
+  const int D = spec.obs_dim, I = D + (cfg_.interval_features ? int(spec.feature_names.size()) : 0);
+  full_.resize(D), next_full_.resize(D), qvals_.resize(2), in_.resize(I), next_in_.resize(I);
   features_.resize(spec.feature_names.size());
   rng_.seed(seed);
   torch::manual_seed(mix_seed(seed, 0x9));
   SwitchQSpec qs = cfg_.net;
-  qs.obs_dim = D + cfg_.features.size();  // q_ab's input: normalised state, then its features
+  qs.obs_dim = I + cfg_.features.size();  // q_ab's input: normalised input, then its periodic features
   q_ = SwitchQNetwork(qs);
   target_ = SwitchQNetwork(qs);
   copy_weights(q_, target_);
@@ -57,14 +57,16 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
   // random attempts) and the scale of the states q_ab will see (its input normaliser).
   const Skill& b = recipe_.skills[tr_.to];
   std::vector<float> act(spec.act_dim);
-  std::vector<double> sum(D, 0.0), sq(D, 0.0);
+  std::vector<double> sum(I, 0.0), sq(I, 0.0);
   int64_t rows = 0, steps = 0;
   const int probes = std::min(20, train_starts_);
   for (int p = 0; p < probes; ++p) {
     starts_.state(p, state_);
     env_->restore_state(state_, full_.data());
+    env_->features(features_.data());
     for (int t = 0; t < 100000; ++t) {
-      for (int j = 0; j < D; ++j) sum[j] += full_[j], sq[j] += double(full_[j]) * full_[j];
+      q_input(full_.data(), in_.data());
+      for (int j = 0; j < I; ++j) sum[j] += in_[j], sq[j] += double(in_[j]) * in_[j];
       ++rows;
       pi_ab_.act(full_.data() + b.obs_begin, 1, act.data());
       StepResult sr = env_->step(act.data(), full_.data());
@@ -74,8 +76,8 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
     }
   }
   interval_length_ = std::max<int>(1, int(steps / probes));
-  std::vector<float> mean(D), inv_std(D);
-  for (int j = 0; j < D; ++j) {
+  std::vector<float> mean(I), inv_std(I);
+  for (int j = 0; j < I; ++j) {
     double m = sum[j] / rows, var = std::max(sq[j] / rows - m * m, 0.0);
     mean[j] = float(m);
     inv_std[j] = float(1.0 / std::max(std::sqrt(var), 1e-2));
@@ -88,8 +90,14 @@ bool SwitchTrainer::hand_over(float* obs) {
   return run_subtask(*env_, after_, tr_.to, obs, cfg_.lookahead, cfg_.max_subtask_steps, &env_steps_);
 }
 
-int SwitchTrainer::greedy(const float* obs) {
-  q_ab_.act(obs, 1, qvals_.data());
+void SwitchTrainer::q_input(const float* obs, float* in) {
+  const int D = int(full_.size());
+  std::copy(obs, obs + D, in);
+  if (cfg_.interval_features) std::copy(features_.begin(), features_.end(), in + D);
+}
+
+int SwitchTrainer::greedy(const float* in) {
+  q_ab_.act(in, 1, qvals_.data());
   return qvals_[SwitchQNetworkImpl::kSwitch] > qvals_[SwitchQNetworkImpl::kStay] ? SwitchQNetworkImpl::kSwitch
                                                                                  : SwitchQNetworkImpl::kStay;
 }
@@ -108,38 +116,39 @@ void SwitchTrainer::store(const float* s, int a, double r, const float* s2, bool
 }
 
 SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
-  const int D = int(full_.size());
   const Skill& b = recipe_.skills[tr_.to];
   std::vector<float> act(env_->spec().act_dim);
   int i = rng_.integer(0, train_starts_ - 1);
   starts_.state(i, state_);
   env_->restore_state(state_, full_.data());
+  env_->features(features_.data());
+  q_input(full_.data(), in_.data());
   const int switch_at = random ? rng_.integer(0, interval_length_ - 1) : -1;
   for (int t = 0;; ++t) {
-    int a = random ? (t == switch_at ? SwitchQNetworkImpl::kSwitch : SwitchQNetworkImpl::kStay) : greedy(full_.data());
+    int a = random ? (t == switch_at ? SwitchQNetworkImpl::kSwitch : SwitchQNetworkImpl::kStay) : greedy(in_.data());
     if (a == SwitchQNetworkImpl::kSwitch) {
-      std::copy(full_.begin(), full_.end(), scratch_.begin());
       bool ok = hand_over(full_.data());
-      store(scratch_.data(), a, ok ? cfg_.r_success : cfg_.r_fail, scratch_.data(), true);
+      store(in_.data(), a, ok ? cfg_.r_success : cfg_.r_fail, in_.data(), true);
       return {ok, t};
     }
     pi_ab_.act(full_.data() + b.obs_begin, 1, act.data());
     StepResult sr = env_->step(act.data(), next_full_.data());
     ++env_steps_;
     env_->features(features_.data());
+    q_input(next_full_.data(), next_in_.data());
     bool left = sr.truncated || !tr_.running(features_.data(), t + 1);
     if (sr.terminated) {  // a fall while staying
-      store(full_.data(), a, cfg_.r_fail, next_full_.data(), true);
+      store(in_.data(), a, cfg_.r_fail, next_in_.data(), true);
       return {false, t + 1};
     }
     if (left) {  // the interval ran out: the forced switch, valued by pi_b's outcome
-      std::copy(next_full_.begin(), next_full_.end(), scratch_.begin());
-      bool ok = hand_over(scratch_.data());
-      store(full_.data(), a, ok ? cfg_.r_success : cfg_.r_fail, next_full_.data(), true);
+      bool ok = hand_over(next_full_.data());
+      store(in_.data(), a, ok ? cfg_.r_success : cfg_.r_fail, next_in_.data(), true);
       return {ok, t + 1};
     }
-    store(full_.data(), a, 0.0, next_full_.data(), false);
-    std::copy(next_full_.begin(), next_full_.begin() + D, full_.begin());
+    store(in_.data(), a, 0.0, next_in_.data(), false);
+    full_.swap(next_full_);
+    in_.swap(next_in_);
   }
 }
 
@@ -291,11 +300,13 @@ MarginChoice SwitchTrainer::choose_margin() {
   for (int i = train_starts_; i < starts_.size(); ++i) {
     starts_.state(i, state_);
     env_->restore_state(state_, full_.data());
+    env_->features(features_.data());
     path.clear(), gap.clear();
     for (int t = 0;; ++t) {
       path.emplace_back();
       env_->save_state(path.back());
-      q_ab_.act(full_.data(), 1, qvals_.data());
+      q_input(full_.data(), in_.data());
+      q_ab_.act(in_.data(), 1, qvals_.data());
       gap.push_back(qvals_[SwitchQNetworkImpl::kSwitch] - qvals_[SwitchQNetworkImpl::kStay]);
       pi_ab_.act(full_.data() + b.obs_begin, 1, act.data());
       StepResult sr = env_->step(act.data(), full_.data());

@@ -86,7 +86,10 @@ class SwitchTrainer {
   Outcome attempt(bool random);
   void store(const float* s, int a, double r, const float* s2, bool done);
   double update();
-  int greedy(const float* obs);
+  int greedy(const float* in);
+  // q_ab's input at the env's current state: the observation `obs`, then (with
+  // switch.interval_features) the task's features, which must be current in features_.
+  void q_input(const float* obs, float* in);
   // pi_b takes over at the state in `obs` (the task observation, updated in place): did it succeed?
   bool hand_over(float* obs);
 
@@ -112,7 +115,7 @@ class SwitchTrainer {
   int train_starts_ = 0;  // S_a's first train_starts_ states train; the rest are held out
   int64_t env_steps_ = 0;
   double wall_seconds_ = 0;
-  std::vector<float> full_, next_full_, scratch_, qvals_;
+  std::vector<float> full_, next_full_, qvals_, in_, next_in_;
   std::vector<double> features_, state_;
 };
 

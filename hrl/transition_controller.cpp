@@ -16,6 +16,7 @@ void TransitionController::reset(const Env& env, const float*) {
 
 void TransitionController::resume(const Env& env, int skill) {
   features_.resize(env.spec().feature_names.size());
+  obs_dim_ = env.spec().obs_dim;
   skill_ = skill;
   transition_ = -1;
 }
@@ -24,6 +25,11 @@ bool TransitionController::hand_over(const float* obs) {
   const TransitionArtefacts& a = artefacts_[transition_];
   if (rule_ == SwitchRule::QNetwork && a.q) {
     float q[2];
+    if (a.q->obs_dim() > obs_dim_) {  // q_ab reads the task's features too
+      q_in_.assign(obs, obs + obs_dim_);
+      q_in_.insert(q_in_.end(), features_.begin(), features_.end());
+      obs = q_in_.data();
+    }
     a.q->act(obs, 1, q);
     return q[1] > q[0];
   }

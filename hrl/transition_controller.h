@@ -21,7 +21,8 @@ enum class SwitchRule { IntervalEnd, QNetwork, TerminationHead };
 
 struct TransitionArtefacts {
   std::optional<Policy> policy;  // pi_ab, on pi_b's observation slice
-  std::optional<Policy> q;       // q_ab, on the task observation: [Q(stay), Q(switch)]
+  std::optional<Policy> q;       // q_ab, on the task observation (then the task's features
+                                 // with switch.interval_features): [Q(stay), Q(switch)]
 };
 
 class TransitionController : public Controller {
@@ -43,7 +44,8 @@ class TransitionController : public Controller {
   std::vector<TransitionArtefacts> artefacts_;  // per transition of the recipe
   SwitchRule rule_;
   std::vector<double> features_;
-  std::vector<float> out_;
+  std::vector<float> out_, q_in_;
+  int obs_dim_ = 0;
   int skill_ = 0, transition_ = -1, steps_ = 0;  // steps_: pi_ab's in this interval
 };
 

@@ -306,10 +306,11 @@ TEST_F(TransitionTraining, PeriodicFeatureKeysAreReadAgainstTheObservation) {
 
 // The switch margin is chosen on held-out S_a states: each margin's success rate equals a
 // by-hand replay with the exported q_ab (margin folded into Q(stay)) from those states.
-// With switch.fourier as well: the trainer's own input (its choice) and the exported q_ab's
-// (the replay) must then agree on the features too.
+// With switch.fourier or switch.interval_features as well: the trainer's own input (its
+// choice) and the exported q_ab's (the replay) must then agree on those inputs too.
 TEST_F(TransitionTraining, SwitchMarginIsChosenOnHeldOutStarts) {
-  for (std::string fourier : {"", "switch.fourier={inputs: [0, 3], periods: [0.5, 2]}"}) {
+  for (std::string fourier :
+       {"", "switch.fourier={inputs: [0, 3], periods: [0.5, 2]}", "switch.interval_features=true"}) {
     SCOPED_TRACE(fourier);
     std::vector<std::string> sets{"switch.validation_starts=4", "switch.margins=[10, -10, 0.05]"};
     if (!fourier.empty()) sets.push_back(fourier);
@@ -330,20 +331,27 @@ TEST_F(TransitionTraining, SwitchMarginIsChosenOnHeldOutStarts) {
     std::vector<float> obs(r.spec.obs_dim), act(r.spec.act_dim), q(2);
     std::vector<double> f(r.spec.feature_names.size()), state;
     const Policy plain = trainer.q_function();
+    const int features = fourier == "switch.interval_features=true" ? int(f.size()) : 0;
+    ASSERT_EQ(plain.obs_dim(), r.spec.obs_dim + features);
+    const std::vector<float> x(plain.obs_dim(), 0.3f);
     for (size_t m = 0; m < c.margins.size(); ++m) {
       Policy q_ab = trainer.q_function(c.margins[m]);
       std::vector<float> q0(2);
-      q_ab.act(obs.data(), 1, q.data());
-      plain.act(obs.data(), 1, q0.data());
+      q_ab.act(x.data(), 1, q.data());
+      plain.act(x.data(), 1, q0.data());
       EXPECT_NEAR(q[0] - q0[0], c.margins[m], 1e-4);
       EXPECT_EQ(q[1], q0[1]);
       int succeeded = 0;
       for (int i = 6; i < 10; ++i) {
         starts.state(i, state);
         env->restore_state(state, obs.data());
+        env->features(f.data());
         bool fell = false;
         for (;;) {
-          q_ab.act(obs.data(), 1, q.data());
+          std::vector<float> in(obs);
+          if (q_ab.obs_dim() > int(obs.size())) in.insert(in.end(), f.begin(), f.end());
+          ASSERT_EQ(q_ab.obs_dim(), int(in.size()));
+          q_ab.act(in.data(), 1, q.data());
           if (q[1] > q[0]) break;  // switch
           pi_ab.act(obs.data() + b.obs_begin, 1, act.data());
           StepResult sr = env->step(act.data(), obs.data());
@@ -436,6 +444,34 @@ TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
     ASSERT_LT(tpq.transition(), 0);
     if (e1->step(a1.data(), o1.data()).done() | e2->step(a2.data(), o2.data()).done()) break;
   }
+  // switch.interval_features: a q_ab wider than the observation reads the task's features
+  // after it. This one, Q(stay) = 0.2 and Q(switch) = 0.01 since_turn, hands over at the
+  // interval's first state with since_turn > 20, where With TP's pi_ab drove on.
+  const int D = r.spec.obs_dim, F = int(f.size());
+  ASSERT_EQ(r.spec.feature_names[1], "since_turn");
+  ASSERT_GT(driven, 25) << "With TP's pi_ab must drive past since_turn 20 for this check";
+  torch::Tensor w = torch::zeros({2, D + F});
+  w[1][D + 1] = 1.0f;
+  std::vector<float> inv_std(D + F, 1.0f);
+  inv_std[D + 1] = 0.01f;
+  art[0].q = Policy(EigenMlp({w}, {torch::tensor({0.2f, 0.0f})}, Activation::Relu), std::vector<float>(D + F, 0.0f),
+                    inv_std, 5.0f, {-1e9f, -1e9f}, {1e9f, 1e9f});
+  TransitionController by_time(r.skills, r.meta, art, SwitchRule::QNetwork);
+  for (uint64_t seed = 0;; ++seed) {  // With TP's episode
+    env->reset(seed, obs.data());
+    by_time.reset(*env, obs.data());
+    if (by_time.skill() == tr.from) break;
+  }
+  int handed_at = -1;
+  bool begun = false;
+  for (int t = 0; t < 300 && handed_at < 0; ++t) {
+    by_time.act(*env, obs.data(), act.data());
+    env->features(f.data());
+    if (by_time.transition() >= 0) begun = true;
+    else if (begun) handed_at = int(f[1]);
+    if (env->step(act.data(), obs.data()).done()) break;
+  }
+  EXPECT_EQ(handed_at, 21);
 }
 
 TEST_F(TransitionTraining, SubtaskLookaheadEndsAtTheTasksOwnEvents) {
