@@ -139,7 +139,7 @@ void EvolutionStrategy::save(const std::string& path, const std::string& note,
   ar.write("adam_v", doubles(v_));
   ar.write("generation", torch::tensor(std::vector<int64_t>{generation_}, torch::kLong));
   ar.write("counters", torch::tensor(counters, torch::kLong));
-  ar.write("meta_note", torch::tensor(std::vector<int64_t>(note.begin(), note.end()), torch::kLong));
+  ar.write("meta_note", text_tensor(note));
   std::ostringstream bytes;
   ar.save_to(bytes);
   write_file_atomic(path, bytes.str());
@@ -165,8 +165,7 @@ std::vector<int64_t> EvolutionStrategy::load(const std::string& path) {
   m_ = to_doubles(m);
   v_ = to_doubles(v);
   generation_ = int(generation.item<int64_t>());
-  auto c = counters.to(torch::kLong).contiguous();
-  return std::vector<int64_t>(c.data_ptr<int64_t>(), c.data_ptr<int64_t>() + c.numel());
+  return to_int64s(counters);
 }
 
 }  // namespace segue

@@ -25,6 +25,16 @@ std::vector<T> to_vector(const torch::Tensor& t, torch::ScalarType dtype) {
 std::vector<float> to_floats(const torch::Tensor& t) { return to_vector<float, float>(t, torch::kFloat32); }
 std::vector<double> to_doubles(const torch::Tensor& t) { return to_vector<double, double>(t, torch::kFloat64); }
 std::vector<int> to_ints(const torch::Tensor& t) { return to_vector<int, int64_t>(t, torch::kLong); }
+std::vector<int64_t> to_int64s(const torch::Tensor& t) { return to_vector<int64_t, int64_t>(t, torch::kLong); }
+
+torch::Tensor text_tensor(const std::string& s) {
+  return torch::tensor(std::vector<int64_t>(s.begin(), s.end()), torch::kLong);
+}
+
+std::string to_text(const torch::Tensor& t) {
+  std::vector<int64_t> c = to_int64s(t);
+  return std::string(c.begin(), c.end());
+}
 
 torch::nn::Sequential make_mlp(int in, const std::vector<int>& hidden, int out, Activation act,
                                double out_gain) {

@@ -20,6 +20,10 @@ std::string activation_name(Activation a);
 std::vector<float> to_floats(const torch::Tensor& t);
 std::vector<double> to_doubles(const torch::Tensor& t);
 std::vector<int> to_ints(const torch::Tensor& t);
+std::vector<int64_t> to_int64s(const torch::Tensor& t);
+// Text in an archive: one int64 per character.
+torch::Tensor text_tensor(const std::string& s);
+std::string to_text(const torch::Tensor& t);
 
 // Linear layers in→hidden...→out, `act` between them, none after the last. Hidden layers
 // get orthogonal init with gain sqrt(2); the last layer uses `out_gain` (small for a

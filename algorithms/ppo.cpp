@@ -361,7 +361,7 @@ void PPO::save(const std::string& path, const std::string& note, const ArchiveWr
   write_features(ar, s.features);
   ar.write("meta_act_low", torch::tensor(envs_.spec().act_low));
   ar.write("meta_act_high", torch::tensor(envs_.spec().act_high));
-  ar.write("meta_note", torch::tensor(std::vector<int64_t>(note.begin(), note.end()), torch::kLong));
+  ar.write("meta_note", text_tensor(note));
   std::ostringstream bytes;
   ar.save_to(bytes);
   write_file_atomic(path, bytes.str());

@@ -152,11 +152,6 @@ torch::Tensor rows_of(const std::vector<float>& v, int64_t width) {
   return torch::tensor(v).reshape({-1, width});
 }
 
-std::vector<float> floats_of(const torch::Tensor& t) {
-  auto c = t.to(torch::kFloat32).contiguous();
-  return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
-}
-
 }  // namespace
 
 void LeeTrainer::save(const std::string& path, const std::string& note) const {
@@ -187,7 +182,7 @@ void LeeTrainer::load(const std::string& path) {
     ar.read("proximity_negative", neg);
     if (pos.size(1) != obs_dim_ || neg.size(1) != obs_dim_)
       throw Error(path + ": the proximity predictor's states have another width than pi_b's observation");
-    pos_ = floats_of(pos), pos_label_ = floats_of(label), neg_ = floats_of(neg);
+    pos_ = to_floats(pos), pos_label_ = to_floats(label), neg_ = to_floats(neg);
     pos_n_ = seen[0].item<int64_t>(), neg_n_ = seen[1].item<int64_t>();
   });
 }

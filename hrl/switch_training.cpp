@@ -194,17 +194,6 @@ SwitchStats SwitchTrainer::run(int n) {
   return s;
 }
 
-namespace {
-
-torch::Tensor text_tensor(const std::string& s) { return torch::tensor(std::vector<int64_t>(s.begin(), s.end())); }
-
-std::string tensor_text(const torch::Tensor& t) {
-  auto c = t.to(torch::kLong).contiguous();
-  return std::string(c.data_ptr<int64_t>(), c.data_ptr<int64_t>() + c.numel());
-}
-
-}  // namespace
-
 void SwitchTrainer::save(const std::string& path) const {
   torch::serialize::OutputArchive ar, q, target, opt;
   q_->save(q);
@@ -260,19 +249,14 @@ void SwitchTrainer::load(const std::string& path) {
   } catch (const c10::Error&) {
     throw Error(path + ": not a switch-training checkpoint for this recipe's q_ab");
   }
-  auto floats = [](const torch::Tensor& t) {
-    auto c = t.contiguous();
-    return std::vector<float>(c.data_ptr<float>(), c.data_ptr<float>() + c.numel());
-  };
-  obs_ = floats(obs), next_obs_ = floats(next), reward_ = floats(reward), done_ = floats(done);
-  auto a = action.contiguous();
-  action_.assign(a.data_ptr<int64_t>(), a.data_ptr<int64_t>() + a.numel());
+  obs_ = to_floats(obs), next_obs_ = to_floats(next), reward_ = to_floats(reward), done_ = to_floats(done);
+  action_ = to_int64s(action);
   stored_ = counters[0].item<int64_t>();
   attempts_ = int(counters[1].item<int64_t>());
   updates_ = int(counters[2].item<int64_t>());
   env_steps_ = counters[3].item<int64_t>();
   wall_seconds_ = counters[4].item<int64_t>() / 1000.0;
-  rng_.set_state(tensor_text(rng));
+  rng_.set_state(to_text(rng));
   at::Generator gen = at::detail::getDefaultCPUGenerator();
   {
     std::lock_guard<std::mutex> lock(gen.mutex());
