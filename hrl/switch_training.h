@@ -68,8 +68,8 @@ class SwitchTrainer {
   void load(const std::string& path);
   // Environment steps so far: pi_ab's in the interval and pi_b's subtasks after switches.
   int64_t env_steps() const { return env_steps_; }
-  // q_ab as a function of the task observation: forward(obs) -> [Q(stay), Q(switch)],
-  // input normalisation included (exported like a policy, with unbounded outputs). The
+  // q_ab as a function of the task observation (followed by the task's features with
+  // switch.interval_features): forward(obs) -> [Q(stay), Q(switch)], input normalisation included (exported like a policy, with unbounded outputs). The
   // margin is added to Q(stay), so that the exported rule "switch where Q(switch) >
   // Q(stay)" is the rule with the margin.
   Policy q_function(double margin = 0.0) const;
