@@ -369,8 +369,21 @@ void PPO::save(const std::string& path, const std::string& note, const ArchiveWr
 
 void PPO::load(const std::string& path, const ArchiveReader& extra) {
   torch::serialize::InputArchive ar;
-  ar.load_from(path);
-  if (extra) extra(ar);
+  try {
+    ar.load_from(path);
+    if (extra) extra(ar);
+    read_state(ar, path);
+  } catch (const c10::Error& e) {
+    std::string what = e.what_without_backtrace();
+    throw Error(path + ": unreadable checkpoint: " + what.substr(0, what.find('\n')));
+  }
+  // Episodes in flight at the interruption are lost; start fresh ones, seeded by position.
+  envs_.reset(mix_seed(seed_, 0x10000 + iteration_));
+  running_return_.assign(envs_.size(), 0.0);
+  refresh_inference_copy();
+}
+
+void PPO::read_state(torch::serialize::InputArchive& ar, const std::string& path) {
   torch::Tensor dims;
   ar.read("meta_dims", dims);
   if (dims[0].item<int64_t>() != net_->spec.obs_dim || dims[1].item<int64_t>() != net_->spec.act_dim)
@@ -396,10 +409,6 @@ void PPO::load(const std::string& path, const ArchiveReader& extra) {
   global_step_ = counters[1].item<int64_t>();
   wall_seconds_ = counters[2].item<int64_t>() / 1000.0;
   schedule_start_ = counters.numel() > 3 ? counters[3].item<int64_t>() : 0;  // older checkpoints: 0
-  // Episodes in flight at the interruption are lost; start fresh ones, seeded by position.
-  envs_.reset(mix_seed(seed_, 0x10000 + iteration_));
-  running_return_.assign(envs_.size(), 0.0);
-  refresh_inference_copy();
 }
 
 Policy PPO::policy_from_checkpoint(const std::string& path) {

@@ -114,6 +114,7 @@ class PPO {
   static Policy policy_from_checkpoint(const std::string& path);
 
  private:
+  void read_state(torch::serialize::InputArchive& ar, const std::string& path);  // load()'s body
   void sample_actions(int t);
   void refresh_inference_copy();
   // The networks' input for one raw observation: normalised, then the periodic features.

@@ -2,6 +2,8 @@
 // policy's return; and an interrupted run resumes from its checkpoint.
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include "hrl/evaluation.h"
 #include "algorithms/ppo.h"
 #include "environments/registry.h"
@@ -125,6 +127,16 @@ TEST_F(PpoCheckpoints, ResumeRestoresEverythingButInFlightEpisodes) {
   // ...and training goes on from there.
   b.iterate();
   EXPECT_EQ(b.global_step(), 3 * 2048);
+  // A file that is no checkpoint is refused in one line naming it.
+  const std::string bad = path("not_a_checkpoint.pt");
+  std::ofstream(bad) << "garbage";
+  try {
+    b.load(bad);
+    ADD_FAILURE() << "garbage was loaded";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(bad + ": unreadable checkpoint: ", 0), 0u) << e.what();
+    EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(PpoCheckpoints, ARestartedScheduleAnnealsOverTheStagesOwnSteps) {
