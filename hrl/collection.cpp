@@ -169,12 +169,29 @@ void save(const Demonstrations& d, const std::string& path) {
   write(ar, path);
 }
 
+namespace {
+
+// Reads `keys` of the archive at `path` into `out`, or throws naming the file.
+void read_archive(const std::string& path, const std::string& what, const std::vector<std::string>& keys,
+                  std::vector<torch::Tensor*> out) {
+  try {
+    torch::serialize::InputArchive ar;
+    ar.load_from(path);
+    for (size_t i = 0; i < keys.size(); ++i) {
+      ar.read(keys[i], *out[i]);
+      if (out[i]->dim() < 1 || out[i]->size(0) != out[0]->size(0)) throw Error(path + ": rows differ between arrays");
+    }
+  } catch (const c10::Error& e) {
+    std::string why = e.what_without_backtrace();
+    throw Error(path + ": not " + what + " (" + why.substr(0, why.find('\n')) + ")");
+  }
+}
+
+}  // namespace
+
 StartStates load_start_states(const std::string& path) {
-  torch::serialize::InputArchive ar;
-  ar.load_from(path);
   torch::Tensor states, obs;
-  ar.read("states", states);
-  ar.read("obs", obs);
+  read_archive(path, "a file of start states (S_a)", {"states", "obs"}, {&states, &obs});
   StartStates s;
   s.state_dim = int(states.size(1));
   s.obs_dim = int(obs.size(1));
@@ -184,13 +201,8 @@ StartStates load_start_states(const std::string& path) {
 }
 
 Demonstrations load_demonstrations(const std::string& path) {
-  torch::serialize::InputArchive ar;
-  ar.load_from(path);
   torch::Tensor obs, act, next, done;
-  ar.read("obs", obs);
-  ar.read("act", act);
-  ar.read("next_obs", next);
-  ar.read("done", done);
+  read_archive(path, "a file of demonstrations (T_b)", {"obs", "act", "next_obs", "done"}, {&obs, &act, &next, &done});
   Demonstrations d;
   d.obs_dim = int(obs.size(1));
   d.act_dim = int(act.size(1));

@@ -25,6 +25,28 @@ bool exists(const std::string& path) { return fs::exists(path); }
 // The signal number that asked the run to stop, or 0.
 int signal_of(const std::atomic<int>* stop) { return stop ? stop->load() : 0; }
 
+// Transition t's S_a and T_b from its folder, refused (naming the file) when their widths
+// are not this task's and pi_b's: files copied from another task's run.
+StartStates starts_of(const CompositeRecipe& r, const std::string& dir) {
+  const std::string path = dir + "/start_states.pt";
+  StartStates s = load_start_states(path);
+  if (s.obs_dim != r.spec.obs_dim)
+    throw Error(path + ": S_a of observations " + std::to_string(s.obs_dim) + " wide, but task '" + r.spec.name +
+                "' has " + std::to_string(r.spec.obs_dim));
+  return s;
+}
+
+Demonstrations demonstrations_of(const CompositeRecipe& r, int t, const std::string& dir) {
+  const std::string path = dir + "/demonstrations.pt";
+  const Skill& b = r.skills[r.meta.transitions()[t].to];
+  Demonstrations d = load_demonstrations(path);
+  if (d.obs_dim != b.obs_end - b.obs_begin || d.act_dim != r.spec.act_dim)
+    throw Error(path + ": T_b of (s, a) " + std::to_string(d.obs_dim) + " x " + std::to_string(d.act_dim) +
+                " wide, but pi_b takes " + std::to_string(b.obs_end - b.obs_begin) + " x " +
+                std::to_string(r.spec.act_dim));
+  return d;
+}
+
 // Returns the signal number when stopped (nothing of the unfinished set is kept), else 0.
 int collect(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
             const std::atomic<int>* stop) {
@@ -51,7 +73,7 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
     // After the hand-over: from S_a's states less those held out for the switch margin.
     StartStates handovers;
     if (tr.expert_after_handover) {
-      handovers = load_start_states(dir + "/start_states.pt");
+      handovers = starts_of(r, dir);
       handovers.keep_first(handovers.size() - r.pipeline.switching.validation_starts);
     }
     Demonstrations d = collect_demonstrations(r, t, c.demonstrations, mix_seed(r.pipeline.seed, 2 * t + 1),
@@ -101,11 +123,11 @@ int train_transition(const CompositeRecipe& r, int t, const std::string& dir, co
   const TransitionPolicyConfig& cfg = r.pipeline.transition;
   const Transition& tr = r.meta.transitions()[t];
   const Skill& b = r.skills[tr.to];
-  StartStates starts = load_start_states(dir + "/start_states.pt");
+  StartStates starts = starts_of(r, dir);
   VectorEnv envs(
       [&] { return std::make_unique<TransitionEnv>(r.make_env(), starts, tr, b.obs_begin, b.obs_end); },
       cfg.ppo.num_envs, o.threads);
-  TransitionPolicyTrainer trainer(cfg, envs, load_demonstrations(dir + "/demonstrations.pt"), b.policy,
+  TransitionPolicyTrainer trainer(cfg, envs, demonstrations_of(r, t, dir), b.policy,
                                   mix_seed(r.pipeline.seed, 100 + t));
   const std::string ckpt = dir + "/transition_checkpoint.pt";
   resume(trainer, ckpt);
@@ -129,11 +151,11 @@ int train_transition(const CompositeRecipe& r, int t, const std::string& dir, co
 int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const PipelineOptions& o) {
   const TransitionPolicyConfig& cfg = r.pipeline.transition;
   const Skill& b = r.skills[r.meta.transitions()[t].to];
-  StartStates starts = load_start_states(dir + "/start_states.pt");
+  StartStates starts = starts_of(r, dir);
   const int subtask_steps = r.pipeline.switching.max_subtask_steps;
   VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r, t, starts, subtask_steps); }, cfg.ppo.num_envs,
                  o.threads);
-  LeeTrainer trainer(cfg, r.pipeline.lee, envs, load_demonstrations(dir + "/demonstrations.pt"), b.policy,
+  LeeTrainer trainer(cfg, r.pipeline.lee, envs, demonstrations_of(r, t, dir), b.policy,
                      mix_seed(r.pipeline.seed, 300 + t));
   const std::string ckpt = dir + "/lee_checkpoint.pt";
   resume(trainer, ckpt);
@@ -157,7 +179,7 @@ int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const Pip
 int train_switch(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
                  const std::atomic<int>* stop) {
   const SwitchConfig& cfg = r.pipeline.switching;
-  SwitchTrainer trainer(cfg, r, t, load_start_states(dir + "/start_states.pt"), Policy::load(dir + "/policy.pt"),
+  SwitchTrainer trainer(cfg, r, t, starts_of(r, dir), Policy::load(dir + "/policy.pt"),
                         load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false),
                         mix_seed(r.pipeline.seed, 200 + t));
   const std::string ckpt = dir + "/switch_checkpoint.pt";
@@ -204,7 +226,7 @@ void write_actions(const CompositeRecipe& r, int t, const std::string& dir, int 
   const Transition& tr = r.meta.transitions()[t];
   const Skill& a = r.skills[tr.from];
   const Skill& b = r.skills[tr.to];
-  StartStates starts = load_start_states(dir + "/start_states.pt");
+  StartStates starts = starts_of(r, dir);
   Policy pi_ab = Policy::load(dir + "/policy.pt");
   auto env = r.make_env();
   std::vector<float> obs(r.spec.obs_dim), act(r.spec.act_dim);

@@ -599,6 +599,40 @@ TEST_F(TransitionTraining, ATransitionsOwnStartStatesOverrideTheCollectSize) {
   }
 }
 
+// S_a or T_b copied in from another task's run is refused, naming the file.
+TEST_F(TransitionTraining, PipelineRefusesStartStatesAndDemonstrationsOfAnotherWidth) {
+  CompositeRecipe r = tiny();
+  PipelineOptions o;
+  o.command = "test";
+  const std::string t = path("run/forward-balance/");
+  fs::create_directories(t);
+  StartStates s = collect_start_states(r, 0, r.pipeline.collect.start_states, 1);
+  Demonstrations d = collect_demonstrations(r, 0, 50, 2);
+  StartStates narrow = s;
+  narrow.obs_dim = s.obs_dim - 1;
+  narrow.obs.resize(size_t(narrow.size()) * narrow.obs_dim);
+  save(narrow, t + "start_states.pt");
+  save(d, t + "demonstrations.pt");
+  auto message = [&] {
+    try {
+      run_pipeline(r, o);
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message(), t + "start_states.pt: S_a of observations " + std::to_string(s.obs_dim - 1) +
+                           " wide, but task 'patrol' has " + std::to_string(s.obs_dim));
+  save(s, t + "start_states.pt");
+  Demonstrations wide = d;
+  wide.act_dim = d.act_dim + 1;
+  wide.act.resize(size_t(wide.size()) * wide.act_dim);
+  save(wide, t + "demonstrations.pt");
+  EXPECT_NE(message().find(t + "demonstrations.pt: T_b of (s, a) "), std::string::npos) << message();
+  std::ofstream(t + "demonstrations.pt") << "garbage";
+  EXPECT_EQ(message().rfind(t + "demonstrations.pt: not a file of demonstrations (T_b) (", 0), 0u) << message();
+}
+
 TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
   CompositeRecipe r = tiny();
   PipelineOptions o;
