@@ -69,6 +69,8 @@ SwitchConfig SwitchConfig::read(const Section& s, int obs_dim) {
   c.validation_starts = s.get("validation_starts", c.validation_starts);
   c.margins = s.get("margins", c.margins);
   c.interval_features = s.get("interval_features", c.interval_features);
+  c.ensemble = s.get("ensemble", c.ensemble);
+  if (c.ensemble < 1) throw s.error("ensemble", "must be at least 1");
   if (s.has("fourier")) c.features = ObsFeatures::read(s.sub("fourier"), obs_dim);  // only when given
   if (!(c.net.gamma > 0 && c.net.gamma <= 1)) throw s.error("gamma", "must be in (0, 1]");
   if (c.validation_starts < 0) throw s.error("validation_starts", "must be >= 0");

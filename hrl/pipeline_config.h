@@ -88,6 +88,11 @@ struct SwitchConfig {
   // state (Patrol's walker stands still through walk->balance's 100 steps), q_ab cannot
   // tell how soon the forced switch comes.
   bool interval_features = false;
+  // `ensemble: K`: K q-networks, each a double DQN on the same replay buffer with its own
+  // initialisation and minibatches; q_ab is their mean (exported as one MLP, K times as
+  // wide, block-diagonal). 1 is the paper's single network. The mean's estimation noise
+  // is smaller, and noise is what makes a greedy q_ab switch early for nothing.
+  int ensemble = 1;
 
   // obs_dim: the composite task's observation width (the features' inputs index it).
   static SwitchConfig read(const Section& s, int obs_dim);

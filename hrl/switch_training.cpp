@@ -48,10 +48,12 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
   torch::manual_seed(mix_seed(seed, 0x9));
   SwitchQSpec qs = cfg_.net;
   qs.obs_dim = I + cfg_.features.size();  // q_ab's input: normalised input, then its periodic features
-  q_ = SwitchQNetwork(qs);
-  target_ = SwitchQNetwork(qs);
-  copy_weights(q_, target_);
-  opt_ = std::make_unique<torch::optim::Adam>(q_->parameters(), torch::optim::AdamOptions(cfg_.lr));
+  for (int k = 0; k < cfg_.ensemble; ++k) {
+    q_.push_back(SwitchQNetwork(qs));
+    target_.push_back(SwitchQNetwork(qs));
+    copy_weights(q_[k], target_[k]);
+    opt_.push_back(std::make_unique<torch::optim::Adam>(q_[k]->parameters(), torch::optim::AdamOptions(cfg_.lr)));
+  }
 
   // Probe pi_ab through the interval from a few starts: how long the interval lasts (for
   // random attempts) and the scale of the states q_ab will see (its input normaliser).
@@ -83,7 +85,32 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
     inv_std[j] = float(1.0 / std::max(std::sqrt(var), 1e-2));
   }
   const float inf = std::numeric_limits<float>::infinity();
-  q_ab_ = Policy(EigenMlp(q_->q, Activation::Relu), mean, inv_std, 5.0f, {-inf, -inf}, {inf, inf}, cfg_.features);
+  q_ab_ = Policy(mean_network(), mean, inv_std, 5.0f, {-inf, -inf}, {inf, inf}, cfg_.features);
+}
+
+EigenMlp SwitchTrainer::mean_network() const {
+  if (q_.size() == 1) return EigenMlp(q_[0]->q, Activation::Relu);
+  // Side by side: the first layer stacks the members' rows, hidden layers are
+  // block-diagonal, and the output layer averages the members' outputs.
+  std::vector<std::vector<torch::Tensor>> w, b;  // [layer][member]
+  for (const auto& net : q_) {
+    int layer = 0;
+    for (const auto& m : net->q->children())
+      if (auto* lin = m->as<torch::nn::Linear>()) {
+        w.resize(std::max<size_t>(w.size(), layer + 1)), b.resize(w.size());
+        w[layer].push_back(lin->weight.detach()), b[layer].push_back(lin->bias.detach());
+        ++layer;
+      }
+  }
+  const double K = double(q_.size());
+  std::vector<torch::Tensor> ws, bs;
+  for (size_t l = 0; l < w.size(); ++l) {
+    if (l == 0) ws.push_back(torch::cat(w[l], 0));
+    else if (l + 1 < w.size()) ws.push_back(torch::block_diag(w[l]));
+    else ws.push_back(torch::cat(w[l], 1) / K);
+    bs.push_back(l + 1 < w.size() ? torch::cat(b[l], 0) : torch::stack(b[l]).mean(0));
+  }
+  return EigenMlp(ws, bs, Activation::Relu);
 }
 
 bool SwitchTrainer::hand_over(float* obs) {
@@ -155,17 +182,22 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
 double SwitchTrainer::update() {
   const int64_t n = std::min<int64_t>(stored_, cfg_.replay), I = q_ab_.in_dim();
   auto idx = torch::randint(n, {cfg_.batch}, torch::kLong);
-  auto obs = torch::from_blob(obs_.data(), {n, I}).index_select(0, idx);
-  auto next = torch::from_blob(next_obs_.data(), {n, I}).index_select(0, idx);
-  auto action = torch::from_blob(action_.data(), {n}, torch::kLong).index_select(0, idx);
-  auto reward = torch::from_blob(reward_.data(), {n}).index_select(0, idx);
-  auto done = torch::from_blob(done_.data(), {n}).index_select(0, idx);
-  auto loss = double_dqn_loss(q_, target_, obs, action, reward, next, done, cfg_.net.gamma);  // Eq. 4
-  opt_->zero_grad();
-  loss.backward();
-  opt_->step();
-  if (++updates_ % cfg_.target_every == 0) copy_weights(q_, target_);
-  double l = loss.item<double>();
+  double l = 0;
+  for (size_t k = 0; k < q_.size(); ++k) {
+    if (k > 0) idx = torch::randint(n, {cfg_.batch}, torch::kLong);  // each member its own minibatch
+    auto obs = torch::from_blob(obs_.data(), {n, I}).index_select(0, idx);
+    auto next = torch::from_blob(next_obs_.data(), {n, I}).index_select(0, idx);
+    auto action = torch::from_blob(action_.data(), {n}, torch::kLong).index_select(0, idx);
+    auto reward = torch::from_blob(reward_.data(), {n}).index_select(0, idx);
+    auto done = torch::from_blob(done_.data(), {n}).index_select(0, idx);
+    auto loss = double_dqn_loss(q_[k], target_[k], obs, action, reward, next, done, cfg_.net.gamma);  // Eq. 4
+    opt_[k]->zero_grad();
+    loss.backward();
+    opt_[k]->step();
+    l += loss.item<double>() / double(q_.size());
+  }
+  if (++updates_ % cfg_.target_every == 0)
+    for (size_t k = 0; k < q_.size(); ++k) copy_weights(q_[k], target_[k]);
   if (!std::isfinite(l)) throw Error("switch Q-network loss became " + std::to_string(l));
   return l;
 }
@@ -195,13 +227,17 @@ SwitchStats SwitchTrainer::run(int n) {
 }
 
 void SwitchTrainer::save(const std::string& path) const {
-  torch::serialize::OutputArchive ar, q, target, opt;
-  q_->save(q);
-  target_->save(target);
-  opt_->save(opt);
-  ar.write("q", q);
-  ar.write("target", target);
-  ar.write("optimizer", opt);
+  torch::serialize::OutputArchive ar;
+  for (size_t k = 0; k < q_.size(); ++k) {
+    torch::serialize::OutputArchive q, target, opt;
+    q_[k]->save(q);
+    target_[k]->save(target);
+    opt_[k]->save(opt);
+    const std::string member = k ? std::to_string(k) : "";  // one network: the paper's names
+    ar.write("q" + member, q);
+    ar.write("target" + member, target);
+    ar.write("optimizer" + member, opt);
+  }
   const int64_t rows = std::min<int64_t>(stored_, cfg_.replay), I = q_ab_.in_dim();
   auto blob = [](const auto& v, std::vector<int64_t> shape, torch::Dtype type) {
     return torch::from_blob(const_cast<void*>(static_cast<const void*>(v.data())), shape, type);
@@ -225,7 +261,7 @@ void SwitchTrainer::save(const std::string& path) const {
 }
 
 void SwitchTrainer::load(const std::string& path) {
-  torch::serialize::InputArchive ar, q, target, opt;
+  torch::serialize::InputArchive ar;
   torch::Tensor obs, next, action, reward, done, counters, rng, torch_rng;
   try {
     ar.load_from(path);
@@ -233,12 +269,16 @@ void SwitchTrainer::load(const std::string& path) {
     if (obs.dim() != 2 || obs.size(1) != q_ab_.in_dim())
       throw Error(path + ": the checkpoint's q_ab input width differs from the recipe's (" +
                   std::to_string(q_ab_.in_dim()) + ")");
-    ar.read("q", q);
-    ar.read("target", target);
-    ar.read("optimizer", opt);
-    q_->load(q);
-    target_->load(target);
-    opt_->load(opt);
+    for (size_t k = 0; k < q_.size(); ++k) {
+      torch::serialize::InputArchive q, target, opt;
+      const std::string member = k ? std::to_string(k) : "";
+      ar.read("q" + member, q);
+      ar.read("target" + member, target);
+      ar.read("optimizer" + member, opt);
+      q_[k]->load(q);
+      target_[k]->load(target);
+      opt_[k]->load(opt);
+    }
     ar.read("replay_next_obs", next);
     ar.read("replay_action", action);
     ar.read("replay_reward", reward);
@@ -266,7 +306,7 @@ void SwitchTrainer::load(const std::string& path) {
 }
 
 Policy SwitchTrainer::q_function(double margin) const {
-  std::vector<float> theta = EigenMlp(q_->q, Activation::Relu).parameters();
+  std::vector<float> theta = mean_network().parameters();
   theta[theta.size() - 2 + SwitchQNetworkImpl::kStay] += float(margin);  // the last layer's bias
   return q_ab_.with_parameters(theta);
 }

@@ -77,6 +77,7 @@ class SwitchTrainer {
   // the margin); each margin's hand-over point is the first state where Q(switch) > Q(stay)
   // + m, else the interval's end; pi_b is judged from each distinct point as in training.
   MarginChoice choose_margin();
+  const std::vector<SwitchQNetwork>& networks() const { return q_; }
 
  private:
   struct Outcome {
@@ -100,8 +101,10 @@ class SwitchTrainer {
   Policy pi_ab_;
   std::unique_ptr<Env> env_;
   TransitionController after_;  // judges a hand-over: pi_b, then With TP (run_subtask)
-  SwitchQNetwork q_{nullptr}, target_{nullptr};
-  std::unique_ptr<torch::optim::Adam> opt_;
+  // The ensemble's members (switch.ensemble; one for the paper's q_ab), each with its target.
+  std::vector<SwitchQNetwork> q_, target_;
+  std::vector<std::unique_ptr<torch::optim::Adam>> opt_;
+  EigenMlp mean_network() const;  // the members' mean as one MLP
   // q_ab for per-step inference, as q_function() exports it: input (s - mean) / std from
   // the probe clipped to +-5, then switch.fourier's features of s; refreshed after updates.
   Policy q_ab_;

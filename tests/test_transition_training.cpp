@@ -211,8 +211,50 @@ TEST_F(TransitionTraining, SwitchQNetworkExportsAsAPolicy) {
 
 // A switch stage stopped and resumed from its checkpoint trains exactly the q_ab an
 // unbroken one does: same attempts, same minibatches, same weights.
+// With switch.ensemble: K, q_ab is the members' mean: the exported network (one MLP, K
+// times as wide) equals the average of the members' own LibTorch forwards.
+TEST_F(TransitionTraining, SwitchEnsembleExportsTheMembersMean) {
+  CompositeRecipe r = tiny({"switch.ensemble=3"});
+  const Skill& b = r.skills[r.meta.transitions()[0].to];
+  SwitchTrainer trainer(r.pipeline.switching, r, 0, collect_start_states(r, 0, 6, 1), b.policy, {}, 4);
+  EXPECT_GT(trainer.run(24).loss, 0.0);
+  ASSERT_EQ(trainer.networks().size(), 3u);
+  Policy q = trainer.q_function(0.25);
+  q.export_torchscript(path("q3.pt"));
+  Policy back = Policy::load(path("q3.pt"));
+  auto obs = random_obs(8, q.obs_dim(), 11);
+  std::vector<float> in(size_t(8) * q.in_dim()), got(16), got_back(16);
+  q.normalize(obs.data(), 8, in.data());
+  q.act(obs.data(), 8, got.data());
+  back.act(obs.data(), 8, got_back.data());
+  torch::NoGradGuard no_grad;
+  auto x = torch::from_blob(in.data(), {8, q.in_dim()});
+  torch::Tensor mean = torch::zeros({8, 2});
+  for (SwitchQNetwork net : trainer.networks()) mean += net->forward(x) / 3.0;  // holders share the member
+  mean.select(1, 0) += 0.25;  // the margin, on Q(stay)
+  SwitchQNetwork member = trainer.networks()[0];
+  torch::Tensor first = member->forward(x);
+  first.select(1, 0) += 0.25;
+  double spread = 0;
+  for (int n = 0; n < 8; ++n)
+    for (int j = 0; j < 2; ++j) {
+      EXPECT_NEAR(got[2 * n + j], mean[n][j].item<float>(), 1e-5) << n << "," << j;
+      EXPECT_NEAR(got_back[2 * n + j], got[2 * n + j], 1e-5);
+      spread += std::abs(first[n][j].item<float>() - mean[n][j].item<float>());
+    }
+  EXPECT_GT(spread, 1e-3) << "the members are not distinct networks";
+  try {
+    tiny({"switch.ensemble=0"});
+    ADD_FAILURE() << "an empty ensemble was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("key 'switch.ensemble': must be at least 1"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(TransitionTraining, SwitchTrainingResumesExactlyFromItsCheckpoint) {
-  CompositeRecipe r = tiny();
+  for (std::string ensemble : {"1", "3"}) {
+  SCOPED_TRACE("ensemble " + ensemble);
+  CompositeRecipe r = tiny({"switch.ensemble=" + ensemble});
   const Skill& b = r.skills[r.meta.transitions()[0].to];
   StartStates starts = collect_start_states(r, 0, 6, 1);
   auto make = [&] { return std::make_unique<SwitchTrainer>(r.pipeline.switching, r, 0, starts, b.policy,
@@ -244,6 +286,7 @@ TEST_F(TransitionTraining, SwitchTrainingResumesExactlyFromItsCheckpoint) {
     EXPECT_NE(std::string(e.what()).find("switch_checkpoint.pt: the checkpoint's q_ab input width differs"),
               std::string::npos)
         << e.what();
+  }
   }
 }
 
