@@ -181,10 +181,9 @@ SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
 
 double SwitchTrainer::update() {
   const int64_t n = std::min<int64_t>(stored_, cfg_.replay), I = q_ab_.in_dim();
-  auto idx = torch::randint(n, {cfg_.batch}, torch::kLong);
   double l = 0;
   for (size_t k = 0; k < q_.size(); ++k) {
-    if (k > 0) idx = torch::randint(n, {cfg_.batch}, torch::kLong);  // each member its own minibatch
+    auto idx = torch::randint(n, {cfg_.batch}, torch::kLong);  // each member its own minibatch
     auto obs = torch::from_blob(obs_.data(), {n, I}).index_select(0, idx);
     auto next = torch::from_blob(next_obs_.data(), {n, I}).index_select(0, idx);
     auto action = torch::from_blob(action_.data(), {n}, torch::kLong).index_select(0, idx);
