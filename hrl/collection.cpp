@@ -4,11 +4,14 @@
 
 #include <sstream>
 
+#include "algorithms/mlp.h"
 #include "core/rng.h"
 #include "core/run_dir.h"
 #include "environments/registry.h"
 
 namespace segue {
+
+std::string transition_source(const CompositeRecipe& r, int t) { return r.spec.name + " " + r.transition_name(t); }
 
 StartStates collect_start_states(const CompositeRecipe& r, int transition, int count, uint64_t seed,
                                  const std::vector<TransitionArtefacts>& trained, int max_episodes,
@@ -22,6 +25,7 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
   std::vector<float> obs(spec.obs_dim), act(spec.act_dim);
   std::vector<double> f(spec.feature_names.size()), state;
   StartStates out;
+  out.source = transition_source(r, transition);
   out.obs_dim = spec.obs_dim;
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {
     if (stop && stop->load()) return out;
@@ -80,6 +84,7 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
   std::vector<float> obs(spec.obs_dim), act(spec.act_dim), prev(D);
   std::vector<double> f(spec.feature_names.size()), state;
   Demonstrations out, window;  // window: this episode's steps, added to out once kept
+  out.source = transition_source(r, transition);
   out.obs_dim = window.obs_dim = D;
   out.act_dim = window.act_dim = spec.act_dim;
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {
@@ -156,6 +161,7 @@ void save(const StartStates& s, const std::string& path) {
   torch::serialize::OutputArchive ar;
   ar.write("states", as_tensor(s.states, s.size(), torch::kFloat64));
   ar.write("obs", as_tensor(s.obs, s.size(), torch::kFloat32));
+  ar.write("source", text_tensor(s.source));
   write(ar, path);
 }
 
@@ -166,14 +172,16 @@ void save(const Demonstrations& d, const std::string& path) {
   ar.write("act", as_tensor(d.act, m, torch::kFloat32));
   ar.write("next_obs", as_tensor(d.next_obs, m, torch::kFloat32));
   ar.write("done", as_tensor(d.done, m, torch::kUInt8));
+  ar.write("source", text_tensor(d.source));
   write(ar, path);
 }
 
 namespace {
 
-// Reads `keys` of the archive at `path` into `out`, or throws naming the file.
+// Reads `keys` of the archive at `path` into `out`, and its source (empty if the file has
+// none), or throws naming the file.
 void read_archive(const std::string& path, const std::string& what, const std::vector<std::string>& keys,
-                  std::vector<torch::Tensor*> out) {
+                  std::vector<torch::Tensor*> out, std::string& source) {
   try {
     torch::serialize::InputArchive ar;
     ar.load_from(path);
@@ -181,6 +189,8 @@ void read_archive(const std::string& path, const std::string& what, const std::v
       ar.read(keys[i], *out[i]);
       if (out[i]->dim() < 1 || out[i]->size(0) != out[0]->size(0)) throw Error(path + ": rows differ between arrays");
     }
+    torch::Tensor text;
+    source = ar.try_read("source", text) ? to_text(text) : "";
   } catch (const c10::Error& e) {
     std::string why = e.what_without_backtrace();
     throw Error(path + ": not " + what + " (" + why.substr(0, why.find('\n')) + ")");
@@ -191,8 +201,8 @@ void read_archive(const std::string& path, const std::string& what, const std::v
 
 StartStates load_start_states(const std::string& path) {
   torch::Tensor states, obs;
-  read_archive(path, "a file of start states (S_a)", {"states", "obs"}, {&states, &obs});
   StartStates s;
+  read_archive(path, "a file of start states (S_a)", {"states", "obs"}, {&states, &obs}, s.source);
   s.state_dim = int(states.size(1));
   s.obs_dim = int(obs.size(1));
   s.states = as_vector<double>(states);
@@ -202,8 +212,9 @@ StartStates load_start_states(const std::string& path) {
 
 Demonstrations load_demonstrations(const std::string& path) {
   torch::Tensor obs, act, next, done;
-  read_archive(path, "a file of demonstrations (T_b)", {"obs", "act", "next_obs", "done"}, {&obs, &act, &next, &done});
   Demonstrations d;
+  read_archive(path, "a file of demonstrations (T_b)", {"obs", "act", "next_obs", "done"}, {&obs, &act, &next, &done},
+               d.source);
   d.obs_dim = int(obs.size(1));
   d.act_dim = int(act.size(1));
   d.obs = as_vector<float>(obs);

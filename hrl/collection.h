@@ -11,7 +11,9 @@
 //        a window). Observations are in pi_b's slice of the task observation. With
 //        `expert.after_handover`, episodes start instead at S_a's states, one each, and
 //        T_b is as large as they give (at most `count`).
-// Both are stored as tensors in a .pt file (torch.load-able) that later stages read back.
+// Both are stored as tensors in a .pt file (torch.load-able) that later stages read back,
+// with the task and transition they were collected for (`source`), so a file copied into
+// another transition's folder is refused rather than trained on.
 #include <algorithm>
 #include <atomic>
 #include <string>
@@ -21,7 +23,11 @@
 
 namespace segue {
 
+// "TASK a-b": what S_a and T_b files of transition t of recipe r say they are.
+std::string transition_source(const CompositeRecipe& r, int t);
+
 struct StartStates {
+  std::string source;          // transition_source; empty in files written before it was kept
   int state_dim = 0, obs_dim = 0;
   std::vector<double> states;  // [N, state_dim], Env::save_state snapshots
   std::vector<float> obs;      // [N, obs_dim], the task observation there
@@ -38,6 +44,7 @@ struct StartStates {
 };
 
 struct Demonstrations {
+  std::string source;                     // as StartStates::source
   int obs_dim = 0, act_dim = 0;
   std::vector<float> obs, act, next_obs;  // [M, obs_dim], [M, act_dim], [M, obs_dim]
   std::vector<uint8_t> done;              // 1 where the episode truly ended

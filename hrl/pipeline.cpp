@@ -25,11 +25,21 @@ bool exists(const std::string& path) { return fs::exists(path); }
 // The signal number that asked the run to stop, or 0.
 int signal_of(const std::atomic<int>* stop) { return stop ? stop->load() : 0; }
 
-// Transition t's S_a and T_b from its folder, refused (naming the file) when their widths
-// are not this task's and pi_b's: files copied from another task's run.
-StartStates starts_of(const CompositeRecipe& r, const std::string& dir) {
+// Refuses S_a or T_b collected for another task or transition (files copied between
+// folders or runs). Files from before sources were kept have none and are let through.
+void check_source(const std::string& source, const CompositeRecipe& r, int t, const std::string& path,
+                  const std::string& what) {
+  const std::string expected = transition_source(r, t);
+  if (!source.empty() && source != expected)
+    throw Error(path + ": " + what + " collected for '" + source + "', but this folder is '" + expected + "'");
+}
+
+// Transition t's S_a and T_b from its folder, refused (naming the file) when they were
+// collected for another transition or their widths are not this task's and pi_b's.
+StartStates starts_of(const CompositeRecipe& r, int t, const std::string& dir) {
   const std::string path = dir + "/start_states.pt";
   StartStates s = load_start_states(path);
+  check_source(s.source, r, t, path, "S_a");
   if (s.obs_dim != r.spec.obs_dim)
     throw Error(path + ": S_a of observations " + std::to_string(s.obs_dim) + " wide, but task '" + r.spec.name +
                 "' has " + std::to_string(r.spec.obs_dim));
@@ -40,6 +50,7 @@ Demonstrations demonstrations_of(const CompositeRecipe& r, int t, const std::str
   const std::string path = dir + "/demonstrations.pt";
   const Skill& b = r.skills[r.meta.transitions()[t].to];
   Demonstrations d = load_demonstrations(path);
+  check_source(d.source, r, t, path, "T_b");
   if (d.obs_dim != b.obs_end - b.obs_begin || d.act_dim != r.spec.act_dim)
     throw Error(path + ": T_b of (s, a) " + std::to_string(d.obs_dim) + " x " + std::to_string(d.act_dim) +
                 " wide, but pi_b takes " + std::to_string(b.obs_end - b.obs_begin) + " x " +
@@ -73,7 +84,7 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
     // After the hand-over: from S_a's states less those held out for the switch margin.
     StartStates handovers;
     if (tr.expert_after_handover) {
-      handovers = starts_of(r, dir);
+      handovers = starts_of(r, t, dir);
       handovers.keep_first(handovers.size() - r.pipeline.switching.validation_starts);
     }
     Demonstrations d = collect_demonstrations(r, t, c.demonstrations, mix_seed(r.pipeline.seed, 2 * t + 1),
@@ -123,7 +134,7 @@ int train_transition(const CompositeRecipe& r, int t, const std::string& dir, co
   const TransitionPolicyConfig& cfg = r.pipeline.transition;
   const Transition& tr = r.meta.transitions()[t];
   const Skill& b = r.skills[tr.to];
-  StartStates starts = starts_of(r, dir);
+  StartStates starts = starts_of(r, t, dir);
   VectorEnv envs(
       [&] { return std::make_unique<TransitionEnv>(r.make_env(), starts, tr, b.obs_begin, b.obs_end); },
       cfg.ppo.num_envs, o.threads);
@@ -151,7 +162,7 @@ int train_transition(const CompositeRecipe& r, int t, const std::string& dir, co
 int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const PipelineOptions& o) {
   const TransitionPolicyConfig& cfg = r.pipeline.transition;
   const Skill& b = r.skills[r.meta.transitions()[t].to];
-  StartStates starts = starts_of(r, dir);
+  StartStates starts = starts_of(r, t, dir);
   const int subtask_steps = r.pipeline.switching.max_subtask_steps;
   VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r, t, starts, subtask_steps); }, cfg.ppo.num_envs,
                  o.threads);
@@ -179,7 +190,7 @@ int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const Pip
 int train_switch(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
                  const std::atomic<int>* stop) {
   const SwitchConfig& cfg = r.pipeline.switching;
-  SwitchTrainer trainer(cfg, r, t, starts_of(r, dir), Policy::load(dir + "/policy.pt"),
+  SwitchTrainer trainer(cfg, r, t, starts_of(r, t, dir), Policy::load(dir + "/policy.pt"),
                         load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false),
                         mix_seed(r.pipeline.seed, 200 + t));
   const std::string ckpt = dir + "/switch_checkpoint.pt";
@@ -226,7 +237,7 @@ void write_actions(const CompositeRecipe& r, int t, const std::string& dir, int 
   const Transition& tr = r.meta.transitions()[t];
   const Skill& a = r.skills[tr.from];
   const Skill& b = r.skills[tr.to];
-  StartStates starts = starts_of(r, dir);
+  StartStates starts = starts_of(r, t, dir);
   Policy pi_ab = Policy::load(dir + "/policy.pt");
   auto env = r.make_env();
   std::vector<float> obs(r.spec.obs_dim), act(r.spec.act_dim);

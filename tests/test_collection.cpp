@@ -112,11 +112,13 @@ TEST_F(CollectionFiles, DemonstrationsArePiBsOwnStepsInItsWindow) {
   EXPECT_EQ(back.act, d.act);
   EXPECT_EQ(back.next_obs, d.next_obs);
   EXPECT_EQ(back.done, d.done);
+  EXPECT_EQ(back.source, r.spec.name + " forward-balance");
   StartStates s = collect_start_states(r, 0, 2, 5);
   save(s, path("s_a.pt"));
   StartStates s2 = load_start_states(path("s_a.pt"));
   EXPECT_EQ(s2.states, s.states);
   EXPECT_EQ(s2.obs, s.obs);
+  EXPECT_EQ(s2.source, back.source);
 }
 
 TEST(Collection, StartStatesWhereATransitionPolicyIntoAHandsOver) {

@@ -643,7 +643,7 @@ TEST_F(TransitionTraining, ATransitionsOwnStartStatesOverrideTheCollectSize) {
 }
 
 // S_a or T_b copied in from another task's run is refused, naming the file.
-TEST_F(TransitionTraining, PipelineRefusesStartStatesAndDemonstrationsOfAnotherWidth) {
+TEST_F(TransitionTraining, PipelineRefusesStartStatesAndDemonstrationsOfAnotherTransitionOrWidth) {
   CompositeRecipe r = tiny();
   PipelineOptions o;
   o.command = "test";
@@ -674,6 +674,21 @@ TEST_F(TransitionTraining, PipelineRefusesStartStatesAndDemonstrationsOfAnotherW
   EXPECT_NE(message().find(t + "demonstrations.pt: T_b of (s, a) "), std::string::npos) << message();
   std::ofstream(t + "demonstrations.pt") << "garbage";
   EXPECT_EQ(message().rfind(t + "demonstrations.pt: not a file of demonstrations (T_b) (", 0), 0u) << message();
+  // Files of the right widths collected for another transition (copied between folders).
+  ASSERT_EQ(s.source, "patrol forward-balance");
+  ASSERT_EQ(d.source, s.source);
+  save(d, t + "demonstrations.pt");
+  StartStates other = s;
+  other.source = "patrol backward-balance";
+  save(other, t + "start_states.pt");
+  EXPECT_EQ(message(), t + "start_states.pt: S_a collected for 'patrol backward-balance', but this folder is "
+                           "'patrol forward-balance'");
+  save(s, t + "start_states.pt");
+  Demonstrations other_d = d;
+  other_d.source = "hurdle walk-jump";
+  save(other_d, t + "demonstrations.pt");
+  EXPECT_EQ(message(), t + "demonstrations.pt: T_b collected for 'hurdle walk-jump', but this folder is "
+                           "'patrol forward-balance'");
 }
 
 TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
