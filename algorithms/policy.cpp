@@ -78,6 +78,7 @@ void Policy::export_torchscript(const std::string& path) const {
   m.register_attribute("n_obs", c10::IntType::get(), int64_t(obs_dim()));
   m.register_attribute("n_act", c10::IntType::get(), int64_t(act_dim()));
   m.register_attribute("activation", c10::StringType::get(), activation_name(mlp_.activation()));
+  if (!source_.empty()) m.register_attribute("source", c10::StringType::get(), source_);
   const size_t layers = mlp_.weights().size();
   std::ostringstream src;
   src << "def obs_dim(self) -> int:\n    return self.n_obs\n"
@@ -124,6 +125,7 @@ Policy Policy::load_torchscript(const std::string& path) {
            to_floats(m.attr("obs_mean").toTensor()), to_floats(m.attr("obs_inv_std").toTensor()),
            float(m.attr("obs_clip").toDouble()), to_floats(m.attr("act_low").toTensor()),
            to_floats(m.attr("act_high").toTensor()), features);
+  if (m.hasattr("source")) p.set_source(m.attr("source").toStringRef());
   // The Eigen forward must be the function the file defines: check on a random batch.
   torch::manual_seed(0);
   auto obs = torch::randn({8, p.obs_dim()}) * 3.0;

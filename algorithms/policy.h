@@ -35,8 +35,13 @@ class Policy {
   // obs: [batch, obs_dim] -> actions: [batch, act_dim]. Allocates only when the batch grows.
   void act(const float* obs, int batch, float* actions) const;
 
+  // What the policy is for, e.g. "hurdle walk-jump pi_ab" (empty: not said). Kept in the
+  // exported file so that a file copied into the wrong place can be refused.
+  const std::string& source() const { return source_; }
+  void set_source(std::string s) { source_ = std::move(s); }
+
   // Writes a TorchScript module with forward(obs[B, obs_dim]) -> actions[B, act_dim],
-  // obs_dim() and act_dim().
+  // obs_dim() and act_dim(), and the attribute `source` where one is set.
   void export_torchscript(const std::string& path) const;
   // Reads an exported .pt or a training checkpoint; throws segue::Error naming the file.
   static Policy load(const std::string& path);
@@ -50,6 +55,7 @@ class Policy {
   std::vector<float> obs_mean_, obs_inv_std_, act_low_, act_high_;
   float obs_clip_ = 10.0f;
   ObsFeatures features_;
+  std::string source_;
   mutable std::vector<float> normalized_;
 };
 

@@ -11,8 +11,6 @@
 
 namespace segue {
 
-std::string transition_source(const CompositeRecipe& r, int t) { return r.spec.name + " " + r.transition_name(t); }
-
 StartStates collect_start_states(const CompositeRecipe& r, int transition, int count, uint64_t seed,
                                  const std::vector<TransitionArtefacts>& trained, int max_episodes,
                                  const std::atomic<int>* stop) {
@@ -25,7 +23,7 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
   std::vector<float> obs(spec.obs_dim), act(spec.act_dim);
   std::vector<double> f(spec.feature_names.size()), state;
   StartStates out;
-  out.source = transition_source(r, transition);
+  out.source = r.transition_source(transition);
   out.obs_dim = spec.obs_dim;
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {
     if (stop && stop->load()) return out;
@@ -84,7 +82,7 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
   std::vector<float> obs(spec.obs_dim), act(spec.act_dim), prev(D);
   std::vector<double> f(spec.feature_names.size()), state;
   Demonstrations out, window;  // window: this episode's steps, added to out once kept
-  out.source = transition_source(r, transition);
+  out.source = r.transition_source(transition);
   out.obs_dim = window.obs_dim = D;
   out.act_dim = window.act_dim = spec.act_dim;
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {

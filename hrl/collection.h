@@ -23,11 +23,8 @@
 
 namespace segue {
 
-// "TASK a-b": what S_a and T_b files of transition t of recipe r say they are.
-std::string transition_source(const CompositeRecipe& r, int t);
-
 struct StartStates {
-  std::string source;          // transition_source; empty in files written before it was kept
+  std::string source;          // CompositeRecipe::transition_source; empty in older files
   int state_dim = 0, obs_dim = 0;
   std::vector<double> states;  // [N, state_dim], Env::save_state snapshots
   std::vector<float> obs;      // [N, obs_dim], the task observation there

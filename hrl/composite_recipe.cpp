@@ -62,6 +62,8 @@ std::string CompositeRecipe::transition_name(int t) const {
   return skills[tr.from].name + "-" + skills[tr.to].name;
 }
 
+std::string CompositeRecipe::transition_source(int t) const { return spec.name + " " + transition_name(t); }
+
 int CompositeRecipe::start_state_count(int t) const {
   const int own = meta.transitions().at(t).start_states;
   return own > 0 ? own : pipeline.collect.start_states;
@@ -78,8 +80,16 @@ std::vector<TransitionArtefacts> load_transition_artefacts(const CompositeRecipe
   for (size_t t = 0; t < out.size(); ++t) {
     const Skill& b = r.skills[r.meta.transitions()[t].to];
     const std::string folder = dir + "/" + r.transition_name(int(t)) + "/";
+    // A file that says it was made for another transition or task (copied between
+    // folders) is refused; older files say nothing and are let through.
+    auto check_source = [&](const Policy& p, const std::string& file) {
+      const std::string expected = r.transition_source(int(t)) + " " + file;
+      if (!p.source().empty() && p.source() != expected)
+        throw Error(folder + file + ": made for '" + p.source() + "', but this is '" + expected + "'");
+    };
     if (std::filesystem::exists(folder + policy_file)) {
       Policy p = Policy::load(folder + policy_file);
+      check_source(p, policy_file);
       EnvSpec slice = r.spec;
       slice.obs_dim = b.obs_end - b.obs_begin;
       slice.act_dim = r.spec.act_dim + (policy_file == "lee.pt" ? 1 : 0);  // Lee's extra output: terminate
@@ -88,6 +98,7 @@ std::vector<TransitionArtefacts> load_transition_artefacts(const CompositeRecipe
     }
     if (with_q && std::filesystem::exists(folder + "q.pt")) {
       Policy q = Policy::load(folder + "q.pt");
+      check_source(q, "q.pt");
       EnvSpec qs = r.spec;
       qs.act_dim = 2;
       const int with_features = qs.obs_dim + int(qs.feature_names.size());  // switch.interval_features

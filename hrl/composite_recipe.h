@@ -51,6 +51,9 @@ struct CompositeRecipe {
   static std::string default_file(const std::string& task);
   // "from-to", e.g. "walk-jump": the transition's folder name among the artefacts.
   std::string transition_name(int t) const;
+  // "TASK from-to", e.g. "hurdle walk-jump": what the files trained for transition t (S_a,
+  // T_b, pi_ab, q_ab, Lee's policy) record they were made for.
+  std::string transition_source(int t) const;
   // |S_a| to collect for transition t: its own `start_states`, else collect.start_states.
   int start_state_count(int t) const;
 };

@@ -25,11 +25,18 @@ bool exists(const std::string& path) { return fs::exists(path); }
 // The signal number that asked the run to stop, or 0.
 int signal_of(const std::atomic<int>* stop) { return stop ? stop->load() : 0; }
 
+// Exports transition t's trained `file` (policy.pt, lee.pt, q.pt) into its folder, saying
+// what it is for (checked by load_transition_artefacts).
+void export_artefact(Policy p, const CompositeRecipe& r, int t, const std::string& dir, const std::string& file) {
+  p.set_source(r.transition_source(t) + " " + file);
+  p.export_torchscript(dir + "/" + file);
+}
+
 // Refuses S_a or T_b collected for another task or transition (files copied between
 // folders or runs). Files from before sources were kept have none and are let through.
 void check_source(const std::string& source, const CompositeRecipe& r, int t, const std::string& path,
                   const std::string& what) {
-  const std::string expected = transition_source(r, t);
+  const std::string expected = r.transition_source(t);
   if (!source.empty() && source != expected)
     throw Error(path + ": " + what + " collected for '" + source + "', but this folder is '" + expected + "'");
 }
@@ -154,7 +161,7 @@ int train_transition(const CompositeRecipe& r, int t, const std::string& dir, co
                                   s.expert_accuracy, s.generator_accuracy, s.ppo.policy_loss, s.ppo.value_loss,
                                   s.ppo.approx_kl, trainer.ppo().wall_seconds()};
                         });
-  if (!stop) trainer.policy().export_torchscript(dir + "/policy.pt");
+  if (!stop) export_artefact(trainer.policy(), r, t, dir, "policy.pt");
   return stop;
 }
 
@@ -180,7 +187,7 @@ int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const Pip
                                   s.handover_success, s.ppo.episode_length, s.predictor_loss, s.ppo.policy_loss,
                                   s.ppo.value_loss, s.ppo.approx_kl, trainer.ppo().wall_seconds()};
                         });
-  if (!stop) trainer.policy().export_torchscript(dir + "/lee.pt");
+  if (!stop) export_artefact(trainer.policy(), r, t, dir, "lee.pt");
   return stop;
 }
 
@@ -224,7 +231,7 @@ int train_switch(const CompositeRecipe& r, int t, const std::string& run, const 
     margin = c.margin;
     spdlog::info("  q_ab: switches where Q(switch) > Q(stay) + {:g}", margin);
   }
-  trainer.q_function(margin).export_torchscript(dir + "/q.pt");
+  export_artefact(trainer.q_function(margin), r, t, dir, "q.pt");
   fs::remove(ckpt);
   spdlog::info("  q_ab: {} attempts, {} environment steps in {}", cfg.attempts, trainer.env_steps(),
                format_duration(trainer.wall_seconds()));

@@ -88,6 +88,12 @@ TEST_F(PolicyFiles, TorchScriptExportRoundTrip) {
     loaded.act(obs.data_ptr<float>(), 9, b.data());
     for (int i = 0; i < 9 * 6; ++i) EXPECT_NEAR(a[i], b[i], 1e-6f) << file;
   }
+  // What a policy is for travels with the exported file; a file without it reads as "".
+  EXPECT_EQ(Policy::load(path("p.pt")).source(), "");
+  mem.set_source("hurdle walk-jump policy.pt");
+  mem.export_torchscript(path("p.pt"));
+  EXPECT_EQ(Policy::load(path("p.pt")).source(), "hurdle walk-jump policy.pt");
+  EXPECT_EQ(torch::jit::load(path("p.pt")).attr("source").toStringRef(), "hurdle walk-jump policy.pt");
 }
 
 // policy.ignore_obs: the trained policy, its checkpoint and its TorchScript all act the

@@ -676,6 +676,7 @@ TEST_F(TransitionTraining, PipelineRefusesStartStatesAndDemonstrationsOfAnotherT
   EXPECT_EQ(message().rfind(t + "demonstrations.pt: not a file of demonstrations (T_b) (", 0), 0u) << message();
   // Files of the right widths collected for another transition (copied between folders).
   ASSERT_EQ(s.source, "patrol forward-balance");
+  ASSERT_EQ(r.transition_source(0), s.source);
   ASSERT_EQ(d.source, s.source);
   save(d, t + "demonstrations.pt");
   StartStates other = s;
@@ -746,6 +747,19 @@ TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
   for (const auto& f : outputs) before.push_back(fs::last_write_time(f));
   EXPECT_EQ(run_pipeline(r, o), 0);
   for (size_t i = 0; i < outputs.size(); ++i) EXPECT_EQ(fs::last_write_time(outputs[i]), before[i]) << outputs[i];
+  // Each exported file says what it is for, and one made for another transition is refused.
+  for (const char* f : {"policy.pt", "q.pt", "lee.pt"})
+    EXPECT_EQ(Policy::load(t + f).source(), std::string("patrol forward-balance ") + f);
+  Policy other = Policy::load(t + "policy.pt");
+  other.set_source("patrol backward-balance policy.pt");
+  other.export_torchscript(t + "policy.pt");
+  try {
+    load_transition_artefacts(r, path("run"), "policy.pt", /*with_q=*/true);
+    ADD_FAILURE() << "a policy.pt made for another transition was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), t + "policy.pt: made for 'patrol backward-balance policy.pt', but this is "
+                                         "'patrol forward-balance policy.pt'");
+  }
 }
 
 }  // namespace segue
