@@ -1,5 +1,5 @@
 // Developer probe (not part of `segue`): search, then clone (expert iteration). The jump's
-// failure is a gait blind to the curb (README, "Jump", stage 11); exploration noise from a
+// failure is a gait blind to the curb (experiments/results/NOTES.md, Jump, stage 11); exploration noise from a
 // failing approach clears ~1% of the time, too rarely for PPO to learn from. Here search
 // pays that price on purpose: each round, for each of N episodes, the policy runs
 // deterministically until the curb's start is D m ahead; if it then fails, up to K
