@@ -62,4 +62,14 @@ torch::Tensor DiscriminatorImpl::loss(const torch::Tensor& expert_logit, const t
   return 0.5 * (expert + generator);
 }
 
+torch::Tensor DiscriminatorImpl::gradient_penalty(const torch::Tensor& obs, const torch::Tensor& act,
+                                                 const torch::Tensor& next_obs, const torch::Tensor& done) {
+  auto s = obs.detach().requires_grad_(true), a = act.detach().requires_grad_(true),
+       s2 = next_obs.detach().requires_grad_(true);
+  // f is a sum over rows of per-row functions, so the gradient of the sum holds each row's.
+  auto grads = torch::autograd::grad({f(s, a, s2, done).sum()}, {s, a, s2}, {}, /*retain_graph=*/true,
+                                     /*create_graph=*/true);
+  return (grads[0].pow(2).sum(-1) + grads[1].pow(2).sum(-1) + grads[2].pow(2).sum(-1)).mean();
+}
+
 }  // namespace segue

@@ -38,6 +38,13 @@ class DiscriminatorImpl : public torch::nn::Module {
                        const torch::Tensor& done, const torch::Tensor& log_pi);
   // Binary cross-entropy of D: expert labelled 1, generator 0 (mean over both batches).
   torch::Tensor loss(const torch::Tensor& expert_logit, const torch::Tensor& generator_logit) const;
+  // The R1 penalty (Mescheder et al. 2018) on expert transitions: E ||grad_(s, a, s') f||^2,
+  // with the graph kept so that it can be minimised. Not in the paper (recipe key
+  // `transition.discriminator.gradient_penalty`, off by default): it keeps f smooth around
+  // T_b, so that once D tells the two apart, Eq. 3 still grades how near pi_ab's
+  // transitions are rather than only saturating.
+  torch::Tensor gradient_penalty(const torch::Tensor& obs, const torch::Tensor& act, const torch::Tensor& next_obs,
+                                 const torch::Tensor& done);
 
   // Fixes the input normalisation from the expert data (mean, std of s and a).
   void set_normalizer(const torch::Tensor& obs_mean, const torch::Tensor& obs_std,

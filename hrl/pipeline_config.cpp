@@ -33,10 +33,12 @@ TransitionPolicyConfig TransitionPolicyConfig::read(const Section& s, int obs_di
   c.disc_lr = d.get("lr", c.disc_lr);
   c.disc_batch = d.get("batch", c.disc_batch);
   c.disc_steps = d.get("steps", c.disc_steps);
+  c.gradient_penalty = d.get("gradient_penalty", c.gradient_penalty);
   if (d.has("fourier")) c.discriminator.features = ObsFeatures::read(d.sub("fourier"), obs_dim);
   if (c.disc_batch <= 0) throw d.error("batch", "must be positive");
   if (c.disc_steps < 0) throw d.error("steps", "must be >= 0");
   if (!(c.disc_lr > 0)) throw d.error("lr", "must be positive");
+  if (!(c.gradient_penalty >= 0)) throw d.error("gradient_penalty", "must be >= 0");
   return c;
 }
 

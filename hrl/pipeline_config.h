@@ -7,7 +7,8 @@
 //   threads: 0
 //   collect: {start_states: 1000, demonstrations: 100000}     # |S_a|, |T_b| per transition
 //   transition: {ppo: {...}, policy: {...}, init_from_next: true,
-//                discriminator: {hidden: [100, 100], lr: 3.0e-4, batch: 256, steps: 16, fourier: {...}}}
+//                discriminator: {hidden: [100, 100], lr: 3.0e-4, batch: 256, steps: 16, gradient_penalty: 0,
+//                                fourier: {...}}}
 //   switch: {attempts: 2000, lr: 1.0e-4, ...}
 #include <string>
 #include <vector>
@@ -44,6 +45,7 @@ struct TransitionPolicyConfig {
   double disc_lr = 3e-4;         // Adam (spec)
   int disc_batch = 256;          // expert and generator rows per discriminator step, each
   int disc_steps = 16;           // discriminator steps per PPO iteration
+  double gradient_penalty = 0.0; // weight of Discriminator::gradient_penalty in D's loss (0: off, the paper's)
 
   // Reads the recipe's `transition:` section (every key has a default) for observations
   // of width obs_dim.

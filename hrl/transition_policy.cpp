@@ -60,17 +60,20 @@ void TransitionPolicyTrainer::discriminate(RolloutBuffer& buf) {
     auto gi = torch::randint(M, {std::min(B, M)}, torch::kLong);
     auto ei = torch::randint(E, {std::min(B, E)}, torch::kLong);
     auto eo = expert_obs_.index_select(0, ei), ea = expert_act_.index_select(0, ei);
+    auto en = expert_next_.index_select(0, ei), ed = expert_done_.index_select(0, ei);
     auto e_logpi = ppo_.log_prob(eo.data_ptr<float>(), ea.data_ptr<float>(), eo.size(0));
-    auto e_logit = disc_->logit(eo, ea, expert_next_.index_select(0, ei), expert_done_.index_select(0, ei), e_logpi);
+    auto e_logit = disc_->logit(eo, ea, en, ed, e_logpi);
     auto g_logit = disc_->logit(obs.index_select(0, gi), act.index_select(0, gi), next.index_select(0, gi),
                                 done.index_select(0, gi), log_pi.index_select(0, gi));
-    auto loss = disc_->loss(e_logit, g_logit);
+    auto bce = disc_->loss(e_logit, g_logit);
+    auto loss = bce;
+    if (cfg_.gradient_penalty > 0) loss = bce + cfg_.gradient_penalty * disc_->gradient_penalty(eo, ea, en, ed);
     disc_opt_->zero_grad();
     loss.backward();
     disc_opt_->step();
     double l = loss.item<double>();
     if (!std::isfinite(l)) throw Error("discriminator loss became " + std::to_string(l));
-    last_.disc_loss += l / cfg_.disc_steps;
+    last_.disc_loss += bce.item<double>() / cfg_.disc_steps;  // the logged loss is D's cross-entropy alone
     last_.expert_accuracy += (e_logit > 0).to(torch::kFloat32).mean().item<double>() / cfg_.disc_steps;
     last_.generator_accuracy += (g_logit < 0).to(torch::kFloat32).mean().item<double>() / cfg_.disc_steps;
   }

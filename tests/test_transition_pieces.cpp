@@ -79,6 +79,60 @@ TEST(Discriminator, NormalisesInputsWithExpertStatisticsClippedAtFive) {
   EXPECT_NEAR(f[1].item<float>(), 5.0, 1e-6);  // (100 - 10) / 2 = 45, clipped
 }
 
+// transition.discriminator.gradient_penalty: E ||grad_(s, a, s') f||^2 on expert rows.
+TEST(Discriminator, GradientPenaltyByHandAndByFiniteDifferences) {
+  DiscriminatorSpec spec;
+  spec.obs_dim = 2;
+  spec.act_dim = 1;
+  spec.hidden = {};
+  spec.gamma = 0.9;
+  Discriminator d(spec);
+  set_linear(d->g, {1, 2, 3}, {0.5}, 1, 3);  // g(s, a) = s1 + 2 s2 + 3 a + 0.5
+  set_linear(d->h, {1, -1}, {0.25}, 1, 2);   // h(s) = s1 - s2 + 0.25
+  auto s = torch::tensor({{1.0f, 2.0f}, {-1.0f, 0.5f}});
+  auto a = torch::tensor({{0.5f}, {-0.5f}});
+  auto s2 = torch::tensor({{3.0f, 1.0f}, {0.0f, 1.0f}});
+  auto done = torch::tensor({0.0f, 1.0f});
+  // df/ds = (1 - 1, 2 + 1) = (0, 3): 9; df/da = 3: 9; df/ds' = 0.9 (1, -1): 1.62, or 0 at
+  // a true end. Rows: 19.62 and 18; mean 18.81.
+  auto penalty = d->gradient_penalty(s, a, s2, done);
+  EXPECT_NEAR(penalty.item<double>(), 18.81, 1e-4);
+  // It is differentiable in D's parameters: for g's weights (w_s1, w_s2, w_a) the mean of
+  // (w_s1 - h1)^2 + (w_s2 - h2)^2 + w_a^2 gives 2 (0, 3, 3); for h's, -2 (w_s - h) plus
+  // the s' term 2 gamma^2 h on the first row only, averaged: (0.81, -6 - 0.81).
+  penalty.backward();
+  auto gw = d->g->ptr(0)->as<torch::nn::Linear>()->weight.grad().reshape({-1});
+  auto hw = d->h->ptr(0)->as<torch::nn::Linear>()->weight.grad().reshape({-1});
+  EXPECT_NEAR(gw[0].item<double>(), 0.0, 1e-5);
+  EXPECT_NEAR(gw[1].item<double>(), 6.0, 1e-5);
+  EXPECT_NEAR(gw[2].item<double>(), 6.0, 1e-5);
+  EXPECT_NEAR(hw[0].item<double>(), 0.81, 1e-5);
+  EXPECT_NEAR(hw[1].item<double>(), -6.81, 1e-5);
+
+  // With hidden layers, against central differences of f in double precision.
+  spec.hidden = {8, 8};
+  torch::manual_seed(3);
+  Discriminator deep(spec);
+  deep->to(torch::kFloat64);
+  auto x = torch::randn({3, 5}, torch::kFloat64);  // rows: s (2), a (1), s' (2)
+  auto dn = torch::tensor({0.0, 1.0, 0.0}, torch::kFloat64);
+  auto f_of = [&](const torch::Tensor& in) {
+    return deep->f(in.slice(1, 0, 2), in.slice(1, 2, 3), in.slice(1, 3, 5), dn);
+  };
+  double want = 0;
+  const double h = 1e-6;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 5; ++j) {
+      auto up = x.clone(), down = x.clone();
+      up[i][j] += h;
+      down[i][j] -= h;
+      double df = (f_of(up)[i].item<double>() - f_of(down)[i].item<double>()) / (2 * h);
+      want += df * df / 3;
+    }
+  double got = deep->gradient_penalty(x.slice(1, 0, 2), x.slice(1, 2, 3), x.slice(1, 3, 5), dn).item<double>();
+  EXPECT_NEAR(got, want, 1e-6 * std::max(1.0, want));
+}
+
 // transition.discriminator.fourier: g and h read [normalised s, sin, cos of 2 pi s_i / P].
 TEST(Discriminator, PeriodicStateFeaturesByHand) {
   DiscriminatorSpec spec;
