@@ -35,7 +35,7 @@ class Policy {
   // obs: [batch, obs_dim] -> actions: [batch, act_dim]. Allocates only when the batch grows.
   void act(const float* obs, int batch, float* actions) const;
 
-  // What the policy is for, e.g. "hurdle walk-jump pi_ab" (empty: not said). Kept in the
+  // What the policy is for, e.g. "hurdle walk-jump q.pt" (empty: not said). Kept in the
   // exported file so that a file copied into the wrong place can be refused.
   const std::string& source() const { return source_; }
   void set_source(std::string s) { source_ = std::move(s); }
