@@ -118,9 +118,7 @@ bool SwitchTrainer::hand_over(float* obs) {
 }
 
 void SwitchTrainer::q_input(const float* obs, float* in) {
-  const int D = int(full_.size());
-  std::copy(obs, obs + D, in);
-  if (cfg_.interval_features) std::copy(features_.begin(), features_.end(), in + D);
+  switch_input(obs, int(full_.size()), features_, cfg_.interval_features, in);
 }
 
 int SwitchTrainer::greedy(const float* in) {

@@ -68,10 +68,11 @@ class SwitchTrainer {
   void load(const std::string& path);
   // Environment steps so far: pi_ab's in the interval and pi_b's subtasks after switches.
   int64_t env_steps() const { return env_steps_; }
-  // q_ab as a function of the task observation (followed by the task's features with
-  // switch.interval_features): forward(obs) -> [Q(stay), Q(switch)], input normalisation included (exported like a policy, with unbounded outputs). The
-  // margin is added to Q(stay), so that the exported rule "switch where Q(switch) >
-  // Q(stay)" is the rule with the margin.
+  // q_ab as a function of switch_input() (the task observation, then the task's features
+  // with switch.interval_features): forward(in) -> [Q(stay), Q(switch)], input
+  // normalisation included (exported like a policy, with unbounded outputs). The margin is
+  // added to Q(stay), so that the exported rule "switch where Q(switch) > Q(stay)" is the
+  // rule with the margin.
   Policy q_function(double margin = 0.0) const;
   // From each held-out start: pi_ab runs through the interval (its path does not depend on
   // the margin); each margin's hand-over point is the first state where Q(switch) > Q(stay)
@@ -88,8 +89,7 @@ class SwitchTrainer {
   void store(const float* s, int a, double r, const float* s2, bool done);
   double update();
   int greedy(const float* in);
-  // q_ab's input at the env's current state: the observation `obs`, then (with
-  // switch.interval_features) the task's features, which must be current in features_.
+  // switch_input() at the env's current state, whose features must be current in features_.
   void q_input(const float* obs, float* in);
   // pi_b takes over at the state in `obs` (the task observation, updated in place): did it succeed?
   bool hand_over(float* obs);

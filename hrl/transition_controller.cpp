@@ -25,12 +25,10 @@ bool TransitionController::hand_over(const float* obs) {
   const TransitionArtefacts& a = artefacts_[transition_];
   if (rule_ == SwitchRule::QNetwork && a.q) {
     float q[2];
-    if (a.q->obs_dim() > obs_dim_) {  // q_ab reads the task's features too
-      q_in_.assign(obs, obs + obs_dim_);
-      q_in_.insert(q_in_.end(), features_.begin(), features_.end());
-      obs = q_in_.data();
-    }
-    a.q->act(obs, 1, q);
+    const bool with_features = a.q->obs_dim() > obs_dim_;  // q_ab reads the task's features too
+    q_in_.resize(size_t(a.q->obs_dim()));
+    switch_input(obs, obs_dim_, features_, with_features, q_in_.data());
+    a.q->act(q_in_.data(), 1, q);
     return q[1] > q[0];
   }
   return false;

@@ -8,6 +8,7 @@
 //                                     positive.
 // Control always passes to pi_b when the interval ends (or its max_steps are spent). A
 // transition without a trained pi_ab is taken as Without TP.
+#include <algorithm>
 #include <optional>
 #include <vector>
 
@@ -21,9 +22,17 @@ enum class SwitchRule { IntervalEnd, QNetwork, TerminationHead };
 
 struct TransitionArtefacts {
   std::optional<Policy> policy;  // pi_ab, on pi_b's observation slice
-  std::optional<Policy> q;       // q_ab, on the task observation (then the task's features
-                                 // with switch.interval_features): [Q(stay), Q(switch)]
+  std::optional<Policy> q;       // q_ab, on switch_input(): [Q(stay), Q(switch)]
 };
+
+// q_ab's input: the task observation (obs_dim numbers), then, for a q_ab trained with
+// switch.interval_features, the task's features. Switch training and the controller both
+// build it here, so the two cannot disagree on its layout.
+inline void switch_input(const float* obs, int obs_dim, const std::vector<double>& features, bool with_features,
+                         float* out) {
+  std::copy(obs, obs + obs_dim, out);
+  if (with_features) std::copy(features.begin(), features.end(), out + obs_dim);
+}
 
 class TransitionController : public Controller {
  public:

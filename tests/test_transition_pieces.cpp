@@ -21,17 +21,27 @@ void set_linear(torch::nn::Sequential& net, std::vector<float> w, std::vector<fl
   linear->bias.copy_(torch::tensor(b));
 }
 
-}  // namespace
-
-TEST(Discriminator, ShapedRewardWithDoneMaskingByHand) {
+// Linear g and h, so every number can be worked out by hand: s and s' have 2 numbers, a 1,
+// gamma 0.9, g(s, a) = s1 + 2 s2 + 3 a + 0.5 and h(s) = s1 - s2 + 0.25.
+DiscriminatorSpec linear_spec() {
   DiscriminatorSpec spec;
   spec.obs_dim = 2;
   spec.act_dim = 1;
-  spec.hidden = {};  // linear g and h, so every number can be worked out by hand
+  spec.hidden = {};
   spec.gamma = 0.9;
-  Discriminator d(spec);
-  set_linear(d->g, {1, 2, 3}, {0.5}, 1, 3);  // g(s, a) = s1 + 2 s2 + 3 a + 0.5
-  set_linear(d->h, {1, -1}, {0.25}, 1, 2);   // h(s) = s1 - s2 + 0.25
+  return spec;
+}
+Discriminator linear_discriminator() {
+  Discriminator d(linear_spec());
+  set_linear(d->g, {1, 2, 3}, {0.5}, 1, 3);
+  set_linear(d->h, {1, -1}, {0.25}, 1, 2);
+  return d;
+}
+
+}  // namespace
+
+TEST(Discriminator, ShapedRewardWithDoneMaskingByHand) {
+  Discriminator d = linear_discriminator();
   auto s = torch::tensor({{1.0f, 2.0f}, {1.0f, 2.0f}});
   auto a = torch::tensor({{0.5f}, {0.5f}});
   auto s2 = torch::tensor({{3.0f, 1.0f}, {3.0f, 1.0f}});
@@ -81,14 +91,7 @@ TEST(Discriminator, NormalisesInputsWithExpertStatisticsClippedAtFive) {
 
 // transition.discriminator.gradient_penalty: E ||grad_(s, a, s') f||^2 on expert rows.
 TEST(Discriminator, GradientPenaltyByHandAndByFiniteDifferences) {
-  DiscriminatorSpec spec;
-  spec.obs_dim = 2;
-  spec.act_dim = 1;
-  spec.hidden = {};
-  spec.gamma = 0.9;
-  Discriminator d(spec);
-  set_linear(d->g, {1, 2, 3}, {0.5}, 1, 3);  // g(s, a) = s1 + 2 s2 + 3 a + 0.5
-  set_linear(d->h, {1, -1}, {0.25}, 1, 2);   // h(s) = s1 - s2 + 0.25
+  Discriminator d = linear_discriminator();
   auto s = torch::tensor({{1.0f, 2.0f}, {-1.0f, 0.5f}});
   auto a = torch::tensor({{0.5f}, {-0.5f}});
   auto s2 = torch::tensor({{3.0f, 1.0f}, {0.0f, 1.0f}});
@@ -110,6 +113,7 @@ TEST(Discriminator, GradientPenaltyByHandAndByFiniteDifferences) {
   EXPECT_NEAR(hw[1].item<double>(), -6.81, 1e-5);
 
   // With hidden layers, against central differences of f in double precision.
+  DiscriminatorSpec spec = linear_spec();
   spec.hidden = {8, 8};
   torch::manual_seed(3);
   Discriminator deep(spec);

@@ -679,17 +679,18 @@ TEST_F(TransitionTraining, PipelineRefusesStartStatesAndDemonstrationsOfAnotherT
   ASSERT_EQ(r.transition_source(0), s.source);
   ASSERT_EQ(d.source, s.source);
   save(d, t + "demonstrations.pt");
-  StartStates other = s;
-  other.source = "patrol backward-balance";
-  save(other, t + "start_states.pt");
-  EXPECT_EQ(message(), t + "start_states.pt: S_a collected for 'patrol backward-balance', but this folder is "
-                           "'patrol forward-balance'");
-  save(s, t + "start_states.pt");
-  Demonstrations other_d = d;
-  other_d.source = "hurdle walk-jump";
-  save(other_d, t + "demonstrations.pt");
-  EXPECT_EQ(message(), t + "demonstrations.pt: T_b collected for 'hurdle walk-jump', but this folder is "
-                           "'patrol forward-balance'");
+  // Saves `data` relabelled as collected for `source` in place of `file`, expects the run
+  // refused, and puts the right file back.
+  auto refused = [&](auto data, const std::string& file, const std::string& what, const std::string& source) {
+    const auto right = data;
+    data.source = source;
+    save(data, t + file);
+    EXPECT_EQ(message(), t + file + ": " + what + " collected for '" + source +
+                             "', but this folder is 'patrol forward-balance'");
+    save(right, t + file);
+  };
+  refused(s, "start_states.pt", "S_a", "patrol backward-balance");
+  refused(d, "demonstrations.pt", "T_b", "hurdle walk-jump");
 }
 
 TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
