@@ -197,6 +197,40 @@ Recipe Recipe::load(const std::string& file, const std::vector<std::string>& ove
   return parse(ss.str(), file, overrides);
 }
 
+namespace {
+void merge_into(YAML::Node base, const YAML::Node& over) {
+  for (const auto& kv : over) {
+    const std::string key = kv.first.Scalar();
+    YAML::Node mine = base[key];
+    if (mine.IsDefined() && mine.IsMap() && kv.second.IsMap()) merge_into(mine, kv.second);
+    else base[key] = YAML::Clone(kv.second);
+  }
+}
+}  // namespace
+
+std::vector<YAML::Node> Recipe::stages() const {
+  std::vector<YAML::Node> out;
+  const YAML::Node list = s_->tree["stages"];
+  if (!list.IsDefined()) return out;
+  if (!list.IsSequence() || list.size() == 0)
+    throw Error(s_->file + ": key 'stages' must be a non-empty list of stages");
+  for (size_t i = 0; i < list.size(); ++i) {
+    if (!list[i].IsMap())
+      throw Error(s_->file + ": key 'stages." + std::to_string(i) + "' must be a mapping of keys");
+    out.push_back(list[i]);
+  }
+  return out;
+}
+
+Recipe Recipe::with_overrides(const YAML::Node& overrides, const std::string& name) const {
+  YAML::Node tree = YAML::Clone(s_->tree);
+  tree.remove("stages");
+  if (overrides.IsMap()) merge_into(tree, overrides);
+  YAML::Emitter e;
+  e << tree;
+  return parse(e.c_str(), name);
+}
+
 Section Recipe::root() const { return Section(s_, ""); }
 const std::string& Recipe::file() const { return s_->file; }
 

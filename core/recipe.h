@@ -64,6 +64,11 @@ class Recipe {
   std::string resolved_yaml() const;
   // The keys among them that the recipe left to their defaults ("ppo.noise_repeat").
   const std::set<std::string>& defaulted_keys() const;
+  // The recipe's `stages:` list (a curriculum), each item as written (empty: none).
+  std::vector<YAML::Node> stages() const;
+  // This recipe without its stages, with `overrides` laid over it (mappings merged key by
+  // key, any other value replaced): one stage of a curriculum, named `name` in errors.
+  Recipe with_overrides(const YAML::Node& overrides, const std::string& name) const;
 
  private:
   explicit Recipe(std::shared_ptr<Section::State> s) : s_(std::move(s)) {}

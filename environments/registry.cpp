@@ -3,6 +3,7 @@
 #include <functional>
 #include <map>
 
+#include "environments/jaco_skills.h"
 #include "environments/walker.h"
 #include "environments/walker_course.h"
 #include "environments/walker_obstacles.h"
@@ -145,6 +146,20 @@ Factory walker_patrol(const std::string& name, const Section& env) {
   return [=] { return std::make_unique<WalkerPatrol>(name, w, c); };
 }
 
+// An arm sub-task: the arm's settings (with the task's reference start noise and random
+// steps) and its rule's, both from `env:`.
+template <class Rule>
+Builder jaco_skill(const std::string& model, bool with_rotation, double init_noise, int random_steps) {
+  return [=](const std::string& name, const Section& env) -> Factory {
+    JacoConfig defaults;
+    defaults.init_noise = init_noise;
+    defaults.init_random_steps = random_steps;
+    JacoConfig c = JacoConfig::read(env, defaults);
+    typename Rule::Config r = Rule::Config::read(env);
+    return [=] { return std::make_unique<JacoSkill<Rule>>(name, c, model, with_rotation, r); };
+  };
+}
+
 const std::map<std::string, Builder>& builders() {
   static const std::map<std::string, Builder> table = {
       {"walker_forward", walker_walk(+1.0)},
@@ -155,6 +170,11 @@ const std::map<std::string, Builder>& builders() {
       {"hurdle", walker_course(hurdle_layout(), 5000)},
       {"obstacle_course", walker_course(obstacle_course_layout(), 5000)},
       {"patrol", walker_patrol},
+      // jaco.md §3: pick and catch see the box's rotation (49 numbers), toss and hit do not (39).
+      {"jaco_pick", jaco_skill<PickRule>("jaco/jaco_box.xml", true, 0.01, 10)},
+      {"jaco_catch", jaco_skill<CatchRule>("jaco/jaco_box.xml", true, 0.01, 10)},
+      {"jaco_toss", jaco_skill<TossRule>("jaco/jaco_ball.xml", false, 0.005, 0)},
+      {"jaco_hit", jaco_skill<HitRule>("jaco/jaco_ball.xml", false, 0.005, 10)},
   };
   return table;
 }

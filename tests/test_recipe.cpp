@@ -135,6 +135,22 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run("train " + lead + " --set lead_in.policy=assets/policies/walker/walker_forward.pt"
                                               " --set 'lead_in.when={hurdle_ahead: [3, 4]}'"),
                         "key 'lead_in.when.hurdle_ahead': the task has no feature 'hurdle_ahead' (features: curb_ahead, curb_behind)");
+  auto arm = write("arm.yaml", "task: jaco_pick\nenv: {curb_x: 3}\n");
+  expect_one_line_error(run("train " + arm), "arm.yaml: unknown key 'env.curb_x'");
+  auto hold = write("hold.yaml", "task: jaco_catch\nenv: {hold_target: [1, 2]}\n");
+  expect_one_line_error(run("train " + hold), "key 'env.hold_target': must be a list of 3 numbers");
+  // Stages are all checked before the first runs: a bad key in the second stops the first.
+  const std::string tiny_run = "run_dir: " + (dir_ / "staged").string() + "\n";
+  auto staged = write("staged.yaml", "task: walker_forward\n" + tiny_run +
+                                         "stages:\n  - {name: a}\n  - {name: b, ppo: {lrr: 1}}\n");
+  expect_one_line_error(run("train " + staged), "staged.yaml (stage b): unknown key 'ppo.lrr'");
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "staged" / "1-a")) << "stage a ran";
+  auto unnamed = write("unnamed.yaml", "task: walker_forward\nstages:\n  - {ppo: {lr: 1}}\n");
+  expect_one_line_error(run("train " + unnamed), "key 'stages.0.name' is required");
+  auto twice = write("twice.yaml", "task: walker_forward\nstages:\n  - {name: a}\n  - {name: a}\n");
+  expect_one_line_error(run("train " + twice), "key 'stages.1.name' repeats the stage name 'a'");
+  auto how = write("how.yaml", "task: walker_forward\nstages:\n  - {name: a}\n  - {name: b, continue: weights}\n");
+  expect_one_line_error(run("train " + how), "key 'stages.1.continue' must be 'checkpoint' or 'policy'");
   auto curbs = write("curbs.yaml", "task: walker_jump\nenv: {curbs: 0}\n");
   expect_one_line_error(run("train " + curbs), "key 'env.curbs': must be at least 1");
   // A composite recipe's transition and switch keys are checked when it is read.
@@ -155,6 +171,10 @@ TEST_F(CliErrors, BadPoliciesAndFlags) {
                         "nope.pt: no such policy file");
   expect_one_line_error(run("eval x.pt --task walker_forward --episodes two"), "--episodes expects an integer");
   expect_one_line_error(run("eval x.pt --task walker_forward --bogus"), "unknown flag --bogus");
+  // A walker skill on the arm.
+  expect_one_line_error(run("eval " + std::string(SEGUE_SOURCE_DIR) + "/assets/policies/walker/walker_forward.pt"
+                            " --task jaco_pick --episodes 1"),
+                        "policy takes obs_dim 26 / act_dim 6, but task 'jaco_pick' has obs_dim 49 / act_dim 9");
   EXPECT_EQ(run("train --help").code, 0);
 }
 

@@ -1,5 +1,5 @@
-// segue bench: throughput on the walker, in physics steps per second so every number is
-// comparable with mujoco-testspeed (Debian's libmujoco-samples) on the same XML.
+// segue bench: throughput on the walker and the arm, in physics steps per second, against
+// bare mj_step replaying the same trajectories (the framework's own overhead).
 #include <mujoco/mujoco.h>
 
 #include <chrono>
@@ -13,6 +13,7 @@
 #include "core/mujoco_env.h"
 #include "core/rng.h"
 #include "core/thread_pool.h"
+#include "core/vector_env.h"
 #include "tools/segue/cli.h"
 
 namespace segue::cli {
@@ -20,16 +21,18 @@ namespace {
 
 const Command kBench{
     "bench",
-    "[--json] [--recipe FILE] [--iterations K]",
-    "Measures on the walker model, in physics steps per second: mujoco-testspeed, our raw\n"
-    "physics loop, rollouts with policy inference, and the full PPO loop (rollout and\n"
-    "update), single-threaded and on every core, with the recipe's PPO settings. Every\n"
-    "mj_step counts, episode resets included.",
+    "[--json] [--iterations K]",
+    "Throughput of the walker and the arm, in physics steps per second (every mj_step\n"
+    "counts, episode resets included). The framework's own overhead is measured against\n"
+    "bare mj_step on the same trajectories: the rollout's controls (and pushes) are\n"
+    "recorded and replayed through mj_step alone. Reported: rollout with policy inference,\n"
+    "the full PPO loop (rollout and update), and the bare replay, on one thread and on every\n"
+    "core, with each robot's skill recipe (walker_forward, jaco_pick); and mujoco-testspeed\n"
+    "on the walker's XML for reference.",
     {},
     {{"json", "", "print one JSON object"},
-     {"recipe", "FILE", "skill recipe whose settings to use (default experiments/primitives/walker_forward.yaml)"},
      {"iterations", "K", "PPO iterations per measurement (default 5)"},
-     {"steps", "N", "physics steps for the raw measurements (default 100000)"}}};
+     {"steps", "N", "physics steps for mujoco-testspeed (default 100000)"}}};
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -49,26 +52,95 @@ double testspeed(const std::string& xml, int steps) {
   return NAN;
 }
 
-// The same loop testspeed runs (mj_step with control noise), through our model loading.
-double physics(const std::string& xml, int steps) {
-  char err[1000] = "";
-  mjModel* m = mj_loadXML(xml.c_str(), nullptr, err, sizeof err);
-  if (!m) throw Error(xml + ": " + err);
-  mjData* d = mj_makeData(m);
-  Rng rng(1);
-  auto t0 = std::chrono::steady_clock::now();
-  for (int i = 0; i < steps; ++i) {
-    for (int j = 0; j < m->nu; ++j) d->ctrl[j] = 0.01 * rng.normal();
-    mj_step(m, d);
+// What one environment's physics did during a rollout: for each episode, the state it
+// started from, then per control step the controls and external forces applied.
+struct Trajectory {
+  struct Episode {
+    std::vector<mjtNum> start;   // qpos, qvel, act, qacc_warmstart
+    std::vector<mjtNum> inputs;  // per control step: ctrl (nu), xfrc_applied (6 nbody)
+  };
+  std::vector<Episode> episodes;
+};
+
+// Forwards to a MuJoCo task and records its trajectory (bench only: copies per step).
+class RecordingEnv : public Env {
+ public:
+  RecordingEnv(std::unique_ptr<Env> inner, Trajectory* out)
+      : inner_(std::move(inner)), mj_(dynamic_cast<MujocoEnv&>(*inner_)), out_(out) {}
+  const EnvSpec& spec() const override { return inner_->spec(); }
+  void reset(uint64_t seed, float* obs) override { inner_->reset(seed, obs), begin(); }
+  void reset(float* obs) override { inner_->reset(obs), begin(); }
+  StepResult step(const float* action, float* obs) override {
+    StepResult r = inner_->step(action, obs);
+    const mjModel* m = mj_.model();
+    const mjData* d = mj_.data();
+    auto& in = out_->episodes.back().inputs;
+    in.insert(in.end(), d->ctrl, d->ctrl + m->nu);
+    in.insert(in.end(), d->xfrc_applied, d->xfrc_applied + 6 * m->nbody);
+    return r;
   }
-  double sps = steps / seconds_since(t0);
-  mj_deleteData(d);
-  mj_deleteModel(m);
-  return sps;
+  void features(double* out) const override { inner_->features(out); }
+  // Starts the record afresh from the current state (the episode in flight goes on).
+  void restart_here() {
+    out_->episodes.clear();
+    begin();
+  }
+  void save_state(std::vector<double>& out) const override { inner_->save_state(out); }
+  void restore_state(const std::vector<double>& s, float* obs) override { inner_->restore_state(s, obs); }
+
+ private:
+  void begin() {
+    const mjModel* m = mj_.model();
+    const mjData* d = mj_.data();
+    Trajectory::Episode e;
+    e.start.insert(e.start.end(), d->qpos, d->qpos + m->nq);
+    e.start.insert(e.start.end(), d->qvel, d->qvel + m->nv);
+    e.start.insert(e.start.end(), d->act, d->act + m->na);
+    e.start.insert(e.start.end(), d->qacc_warmstart, d->qacc_warmstart + m->nv);
+    out_->episodes.push_back(std::move(e));
+  }
+  std::unique_ptr<Env> inner_;
+  MujocoEnv& mj_;
+  Trajectory* out_;
+};
+
+// Replays trajectories through mj_step alone on `threads` threads; returns mj_step calls.
+int64_t replay(const mjModel* model, int frame_skip, const std::vector<Trajectory>& trajectories, int threads,
+               double& seconds) {
+  const int nu = model->nu, nx = 6 * model->nbody, per_step = nu + nx;
+  std::vector<mjData*> data;
+  for (size_t i = 0; i < trajectories.size(); ++i) data.push_back(mj_makeData(model));
+  std::vector<int64_t> steps(trajectories.size(), 0);
+  ThreadPool pool(threads);
+  auto t0 = std::chrono::steady_clock::now();
+  pool.parallel_for(int(trajectories.size()), [&](int begin, int end) {
+    for (int i = begin; i < end; ++i) {
+      mjData* d = data[i];
+      for (const auto& e : trajectories[i].episodes) {
+        const mjtNum* s = e.start.data();
+        mj_resetData(model, d);
+        std::copy(s, s + model->nq, d->qpos), s += model->nq;
+        std::copy(s, s + model->nv, d->qvel), s += model->nv;
+        std::copy(s, s + model->na, d->act), s += model->na;
+        std::copy(s, s + model->nv, d->qacc_warmstart);
+        for (size_t k = 0; k + per_step <= e.inputs.size(); k += per_step) {
+          std::copy(&e.inputs[k], &e.inputs[k] + nu, d->ctrl);
+          std::copy(&e.inputs[k] + nu, &e.inputs[k] + per_step, d->xfrc_applied);
+          for (int f = 0; f < frame_skip; ++f) mj_step(model, d);
+          steps[i] += frame_skip;
+        }
+      }
+    }
+  });
+  seconds = seconds_since(t0);
+  for (mjData* d : data) mj_deleteData(d);
+  int64_t total = 0;
+  for (int64_t n : steps) total += n;
+  return total;
 }
 
-struct LoopRates {
-  double rollout, ppo;
+struct Rates {
+  double rollout, ppo, bare;
 };
 
 // Every mj_step the environments ran, episode resets included.
@@ -78,7 +150,7 @@ int64_t physics_steps(VectorEnv& envs) {
   return n;
 }
 
-LoopRates loop_rates(const SkillRecipe& s, int threads, int iterations) {
+Rates rates(const SkillRecipe& s, int threads, int iterations) {
   set_torch_threads(1);  // as segue train: environments get the threads, LibTorch one
   VectorEnv envs(s.make_env, s.ppo.num_envs, threads);
   PPO ppo(s.ppo, s.net, envs, s.seed);
@@ -90,12 +162,32 @@ LoopRates loop_rates(const SkillRecipe& s, int threads, int iterations) {
     IterationStats st;
     ppo.collect_rollout(st);
   }
-  double rollout = (physics_steps(envs) - n0) / seconds_since(t0);
+  const double rollout = (physics_steps(envs) - n0) / seconds_since(t0);
+
+  // The same seed and settings again, recorded: rollouts are a pure function of the seed,
+  // so these are the trajectories just timed.
+  std::vector<Trajectory> recorded(s.ppo.num_envs);
+  int next = 0;
+  VectorEnv rec_envs([&] { return std::make_unique<RecordingEnv>(s.make_env(), &recorded[next++]); },
+                     s.ppo.num_envs, threads);
+  PPO rec(s.ppo, s.net, rec_envs, s.seed);
+  rec.collect_rollout(warm);
+  for (int i = 0; i < rec_envs.size(); ++i) dynamic_cast<RecordingEnv&>(rec_envs.env(i)).restart_here();
+  for (int i = 0; i < iterations; ++i) {
+    IterationStats st;
+    rec.collect_rollout(st);
+  }
+  auto probe = s.make_env();
+  const auto& mj = dynamic_cast<const MujocoEnv&>(*probe);
+  double bare_seconds = 0;
+  const int64_t bare_steps = replay(mj.model(), mj.frame_skip(), recorded, threads, bare_seconds);
+  const double bare = bare_steps / bare_seconds;
+
   n0 = physics_steps(envs);
   t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < iterations; ++i) ppo.iterate();
-  double full = (physics_steps(envs) - n0) / seconds_since(t0);
-  return {rollout, full};
+  const double full = (physics_steps(envs) - n0) / seconds_since(t0);
+  return {rollout, full, bare};
 }
 
 }  // namespace
@@ -103,39 +195,41 @@ LoopRates loop_rates(const SkillRecipe& s, int threads, int iterations) {
 int bench_main(int argc, char** argv) {
   Args args(kBench, argc, argv);
   if (args.help()) return print_help(kBench);
-  std::string recipe_path = args.get("recipe", std::string(SEGUE_SOURCE_DIR) + "/experiments/primitives/walker_forward.yaml");
   const int iterations = args.get_int("iterations", 5), steps = args.get_int("steps", 100000);
   if (iterations <= 0 || steps <= 0) throw Error("segue bench: --iterations and --steps must be positive");
-  Recipe recipe = Recipe::load(recipe_path);
-  SkillRecipe s = SkillRecipe::read(recipe, "runs/bench");
-  recipe.reject_unknown();
-  const std::string xml = asset_path("walker/walker.xml");
   const int cores = resolve_threads(0);
-
-  double ts = testspeed(xml, steps);
-  set_torch_threads(1);
-  double ph = physics(xml, steps);
-  LoopRates one = loop_rates(s, 1, iterations);
-  LoopRates all = loop_rates(s, cores, iterations);
-
-  if (args.has("json")) {
-    std::printf("%s\n", json_object({{"testspeed_sps", ts},
-                                     {"physics_sps", ph},
-                                     {"rollout_sps", one.rollout},
-                                     {"ppo_sps", one.ppo},
-                                     {"rollout_sps_all_cores", all.rollout},
-                                     {"ppo_sps_all_cores", all.ppo},
-                                     {"cores", double(cores)}})
-                            .c_str());
-  } else {
-    std::printf("walker (%s), physics steps per second; recipe %s\n", xml.c_str(), recipe_path.c_str());
-    std::printf("  mujoco-testspeed (1 thread)   %10.0f\n", ts);
-    std::printf("  segue raw physics (1 thread)  %10.0f  %5.1f%% of testspeed\n", ph, 100 * ph / ts);
-    std::printf("  rollout + inference (1 thr)   %10.0f  %5.1f%%  (target >= 85%%)\n", one.rollout, 100 * one.rollout / ts);
-    std::printf("  full PPO loop (1 thread)      %10.0f  %5.1f%%  (target >= 50%%)\n", one.ppo, 100 * one.ppo / ts);
-    std::printf("  rollout, %d cores             %10.0f  %5.2fx one core\n", cores, all.rollout, all.rollout / one.rollout);
-    std::printf("  full PPO loop, %d cores       %10.0f  %5.2fx one core  (target >= 1.7x)\n", cores, all.ppo, all.ppo / one.ppo);
+  const double ts = testspeed(asset_path("walker/walker.xml"), steps);
+  std::vector<std::pair<std::string, double>> json{{"testspeed_sps", ts}, {"cores", double(cores)}};
+  if (!args.has("json")) std::printf("physics steps per second; mujoco-testspeed on walker.xml, 1 thread: %.0f\n", ts);
+  for (const char* robot : {"walker", "jaco"}) {
+    const std::string path = std::string(SEGUE_SOURCE_DIR) + "/experiments/primitives/" +
+                             (robot == std::string("walker") ? "walker_forward.yaml" : "jaco_pick.yaml");
+    Recipe recipe = Recipe::load(path);
+    SkillRecipe s = SkillRecipe::read(recipe, "runs/bench");
+    recipe.reject_unknown();
+    const Rates one = rates(s, 1, iterations), all = rates(s, cores, iterations);
+    const std::string p = robot == std::string("walker") ? "" : std::string(robot) + "_";
+    for (const auto& [key, value] : std::vector<std::pair<std::string, double>>{
+             {"rollout_sps", one.rollout}, {"ppo_sps", one.ppo}, {"bare_sps", one.bare},
+             {"rollout_vs_bare", one.rollout / one.bare}, {"ppo_vs_bare", one.ppo / one.bare},
+             {"rollout_sps_all_cores", all.rollout}, {"ppo_sps_all_cores", all.ppo},
+             {"bare_sps_all_cores", all.bare}, {"rollout_vs_bare_all_cores", all.rollout / all.bare},
+             {"ppo_vs_bare_all_cores", all.ppo / all.bare}})
+      json.push_back({p + key, value});
+    if (args.has("json")) continue;
+    std::printf("%s (%s, %d envs)\n", robot, s.task.c_str(), s.ppo.num_envs);
+    std::printf("  bare mj_step replay, 1 thread   %10.0f\n", one.bare);
+    std::printf("  rollout + inference, 1 thread   %10.0f  %5.2f of bare  (target >= 0.85)\n", one.rollout,
+                one.rollout / one.bare);
+    std::printf("  full PPO loop, 1 thread         %10.0f  %5.2f of bare  (target >= 0.5)\n", one.ppo,
+                one.ppo / one.bare);
+    std::printf("  bare replay, %d cores            %10.0f  %5.2fx one thread\n", cores, all.bare, all.bare / one.bare);
+    std::printf("  rollout, %d cores                %10.0f  %5.2f of bare, %5.2fx one thread\n", cores, all.rollout,
+                all.rollout / all.bare, all.rollout / one.rollout);
+    std::printf("  full PPO loop, %d cores          %10.0f  %5.2f of bare, %5.2fx one thread\n", cores, all.ppo,
+                all.ppo / all.bare, all.ppo / one.ppo);
   }
+  if (args.has("json")) std::printf("%s\n", json_object(json).c_str());
   return 0;
 }
 

@@ -4,6 +4,11 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <set>
+#include <sstream>
 
 #include <spdlog/spdlog.h>
 
@@ -133,6 +138,18 @@ int train_es(const SkillRecipe& s, const Recipe& recipe, const std::string& reci
   return finish_run(space.policy_at(es.theta()), s, dir, env_steps, wall, threads);
 }
 
+// A skill recipe read whole (its lead-in included), unknown keys refused.
+SkillRecipe read_skill(const Recipe& recipe, const std::string& default_run_dir) {
+  SkillRecipe s = SkillRecipe::read(recipe, default_run_dir);
+  if (recipe.root().has("lead_in"))  // training episodes only: eval_make_env keeps the task's start
+    s.make_env = with_lead_in(s.make_env, LeadIn::read(recipe.root().sub("lead_in"), s.make_env()->spec()));
+  recipe.reject_unknown();
+  return s;
+}
+
+int train_skill(const Recipe& recipe, const SkillRecipe& s);
+int train_stages(const Recipe& recipe, const std::string& default_run_dir);
+
 }  // namespace
 
 int train_main(int argc, char** argv) {
@@ -142,12 +159,151 @@ int train_main(int argc, char** argv) {
   auto sets = args.all("set");
   if (args.has("threads")) sets.push_back("threads=" + args.get("threads", "0"));
   Recipe recipe = Recipe::load(recipe_path, sets);
-  std::string stem = std::filesystem::path(recipe_path).stem().string();
-  SkillRecipe s = SkillRecipe::read(recipe, "runs/" + stem);
-  if (recipe.root().has("lead_in"))  // training episodes only: eval_make_env keeps the task's start
-    s.make_env = with_lead_in(s.make_env, LeadIn::read(recipe.root().sub("lead_in"), s.make_env()->spec()));
-  recipe.reject_unknown();
+  const std::string default_run_dir = "runs/" + std::filesystem::path(recipe_path).stem().string();
+  if (!recipe.stages().empty()) return train_stages(recipe, default_run_dir);
+  return train_skill(recipe, read_skill(recipe, default_run_dir));
+}
 
+namespace {
+
+// A curriculum: `stages:`, each a partial recipe laid over the rest of the file and run in
+// its own directory RUN_DIR/N-NAME. Stage N+1 continues stage N's checkpoint (network,
+// optimiser, normalisers, counters; its ppo.total_steps are its own steps), or with
+// `continue: policy` starts its actor as stage N's policy with a fresh critic. Finished
+// stages are skipped, so rerunning resumes inside the stage that was interrupted.
+struct Stage {
+  std::string name;
+  bool from_policy = false;
+  YAML::Node overrides;
+};
+
+std::vector<Stage> read_stages(const Recipe& recipe) {
+  std::vector<Stage> out;
+  std::set<std::string> names;
+  const std::vector<YAML::Node> items = recipe.stages();
+  for (size_t i = 0; i < items.size(); ++i) {
+    const std::string key = "stages." + std::to_string(i);
+    auto bad = [&](const std::string& sub, const std::string& why) {
+      return Error(recipe.file() + ": key '" + key + "." + sub + "' " + why);
+    };
+    Stage st;
+    st.overrides = YAML::Clone(items[i]);
+    if (!st.overrides["name"].IsDefined() || !st.overrides["name"].IsScalar())
+      throw bad("name", "is required: a name for the stage's directory");
+    st.name = st.overrides["name"].Scalar();
+    if (st.name.empty() || st.name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-") != std::string::npos)
+      throw bad("name", "must be lower-case letters, digits, '_' or '-', got '" + st.name + "'");
+    if (!names.insert(st.name).second) throw bad("name", "repeats the stage name '" + st.name + "'");
+    if (st.overrides["continue"].IsDefined()) {
+      const std::string how = st.overrides["continue"].Scalar();
+      if (how != "checkpoint" && how != "policy") throw bad("continue", "must be 'checkpoint' or 'policy', got '" + how + "'");
+      if (i == 0) throw bad("continue", "is for later stages: the first has nothing to continue");
+      st.from_policy = how == "policy";
+    }
+    for (const char* k : {"run_dir", "stages"})
+      if (st.overrides[k].IsDefined()) throw bad(k, "cannot be set per stage");
+    if (i > 0)
+      for (const char* k : {"init_from", "init_policy"})
+        if (st.overrides[k].IsDefined()) throw bad(k, "is set by the stage before (see 'continue')");
+    st.overrides.remove("name");
+    st.overrides.remove("continue");
+    out.push_back(st);
+  }
+  return out;
+}
+
+std::string stage_dir(const std::string& top, size_t i, const Stage& st) {
+  return top + "/" + std::to_string(i + 1) + "-" + st.name;
+}
+
+double eval_env_steps(const std::string& eval_json) {
+  std::smatch m;
+  const std::string text = read_file(eval_json);
+  if (!std::regex_search(text, m, std::regex("\"env_steps\":\\s*([0-9.eE+]+)")))
+    throw Error(eval_json + ": no env_steps");
+  return std::stod(m[1]);
+}
+
+// RUN_DIR/metrics.csv: every stage's rows in order, the stage's name in a first column.
+void write_stage_metrics(const std::string& top, const std::vector<Stage>& stages) {
+  std::vector<std::string> columns;
+  std::vector<std::pair<std::string, std::map<std::string, std::string>>> rows;
+  for (size_t i = 0; i < stages.size(); ++i) {
+    std::ifstream in(stage_dir(top, i, stages[i]) + "/metrics.csv");
+    std::string line;
+    if (!std::getline(in, line)) continue;
+    std::vector<std::string> header;
+    std::stringstream hs(line);
+    for (std::string c; std::getline(hs, c, ',');) {
+      header.push_back(c);
+      if (std::find(columns.begin(), columns.end(), c) == columns.end()) columns.push_back(c);
+    }
+    while (std::getline(in, line)) {
+      std::map<std::string, std::string> row;
+      std::stringstream ls(line);
+      size_t k = 0;
+      for (std::string v; std::getline(ls, v, ',') && k < header.size(); ++k) row[header[k]] = v;
+      rows.push_back({stages[i].name, row});
+    }
+  }
+  std::string out = "stage";
+  for (const auto& c : columns) out += "," + c;
+  out += "\n";
+  for (const auto& [name, row] : rows) {
+    out += name;
+    for (const auto& c : columns) out += "," + (row.count(c) ? row.at(c) : "");
+    out += "\n";
+  }
+  write_file_atomic(top + "/metrics.csv", out);
+}
+
+int train_stages(const Recipe& recipe, const std::string& default_run_dir) {
+  const std::vector<Stage> stages = read_stages(recipe);
+  const std::string top = recipe.root().get("run_dir", default_run_dir);
+  // Stage i's recipe: the file, the stage's keys over it, then where it starts from.
+  auto stage_recipe = [&](size_t i, const std::string& start, int64_t total_steps) {
+    YAML::Node ov = YAML::Clone(stages[i].overrides);
+    ov["run_dir"] = stage_dir(top, i, stages[i]);
+    if (i > 0) ov[stages[i].from_policy ? "init_policy" : "init_from"] = start;
+    if (total_steps > 0) ov["ppo"]["total_steps"] = total_steps;
+    return recipe.with_overrides(ov, recipe.file() + " (stage " + stages[i].name + ")");
+  };
+  // Every stage is read and checked before the first step of the first.
+  for (size_t i = 0; i < stages.size(); ++i) read_skill(stage_recipe(i, "(the stage before)", 0), top);
+  std::filesystem::create_directories(top);
+  for (size_t i = 0; i < stages.size(); ++i) {
+    const std::string dir = stage_dir(top, i, stages[i]);
+    if (std::filesystem::exists(dir + "/eval.json")) {
+      spdlog::info("stage {}/{} '{}' is done ({})", i + 1, stages.size(), stages[i].name, dir);
+      continue;
+    }
+    std::string start;
+    int64_t total = 0;
+    if (i > 0) {
+      const std::string prev = stage_dir(top, i - 1, stages[i - 1]);
+      start = prev + (stages[i].from_policy ? "/policy.pt" : "/checkpoint.pt");
+      // Continuing a checkpoint: the stage's own steps on top of those it has done.
+      if (!stages[i].from_policy)
+        total = int64_t(eval_env_steps(prev + "/eval.json")) +
+                SkillRecipe::read(stage_recipe(i, start, 0), top).ppo.total_steps;
+    }
+    const Recipe r = stage_recipe(i, start, total);
+    spdlog::info("stage {}/{} '{}' in {}", i + 1, stages.size(), stages[i].name, dir);
+    const int rc = train_skill(r, read_skill(r, top));
+    write_stage_metrics(top, stages);
+    if (rc != 0) return rc;
+  }
+  write_stage_metrics(top, stages);
+  const std::string last = stage_dir(top, stages.size() - 1, stages.back());
+  for (const char* f : {"policy.pt", "eval.json", "checkpoint.pt"})
+    std::filesystem::copy_file(last + "/" + f, top + "/" + f, std::filesystem::copy_options::overwrite_existing);
+  write_file_atomic(top + "/recipe.yaml", read_file(recipe.file()));
+  spdlog::info("curriculum done: {} stages; policy {}/policy.pt", stages.size(), top);
+  return 0;
+}
+
+int train_skill(const Recipe& recipe, const SkillRecipe& s) {
+  const std::string recipe_path = recipe.file();
   const int threads = resolve_threads(s.threads);
   // LibTorch runs on one thread: the networks are too small to gain from more, and a
   // fixed thread count keeps floating-point sums, and so the trained policy, the same
@@ -215,4 +371,5 @@ int train_main(int argc, char** argv) {
   return finish_run(ppo.policy(), s, dir, ppo.global_step(), ppo.wall_seconds(), threads);
 }
 
+}  // namespace
 }  // namespace segue::cli

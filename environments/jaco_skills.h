@@ -1,0 +1,170 @@
+#pragma once
+// The arm's four sub-tasks (../shared/spec/jaco.md §3): pick, catch, toss, hit. Each rule is
+// a small struct (its settings, its bookkeeping, one step of scoring) so that the composite
+// tasks, which run the same rules in sequence or repeatedly, reuse them unchanged.
+#include "environments/jaco.h"
+
+namespace segue {
+
+// What one step of a rule decided, beside the reward it added.
+struct RuleStep {
+  double reward = 0.0;
+  bool success = false;
+  bool failed = false;
+};
+
+// Pick: lift the box and hold it in the air for hold_steps steps.
+struct PickRule {
+  struct Config {
+    double in_hand = 0.06, in_air = 0.05;
+    Vec3 tile{0.5, 0.2, 0.03};   // the box starts at tile + (U(0, tile_size), U(0, tile_size), 0)
+    double tile_size = 0.1;
+    double quat_noise = 0.01, vel_noise = 0.01;
+    double guide_weight = 2.0;   // 2 (previous - current |hand - box|) until picked
+    double lift_weight = 100.0;  // 100 (min(lift_cap, z) - best height so far), when positive
+    double lift_cap = 0.3;
+    double hold_height = 0.3;    // the hold target is (box x, box y, hold_height) at placement
+    double hold_weight = 2.0;    // 2 (1 - |target - box|) on each held step
+    int hold_steps = 50;
+    double time_bonus = 1.0;     // time_bonus (max_steps - t) at success
+    static Config read(const Section& env);
+  };
+  struct State {
+    double prev_dist = 0, pick_height = 0, held = 0, picked = 0;
+    Vec3 target{0, 0, 0};
+  };
+  Config cfg;
+  State s;
+
+  void place(JacoEnv& env, Rng& rng) const;
+  void begin(const JacoEnv& env);
+  // t: steps since the pick began; max_steps: its time limit.
+  RuleStep step(const JacoEnv& env, int t, int max_steps);
+};
+
+// Catch: the box is thrown at the arm; hold it in the air for hold_steps steps (cumulative).
+struct CatchRule {
+  struct Config {
+    double in_hand = 0.06, in_air = 0.05, on_ground = 0.05;
+    Vec3 start{0.0, 2.0, 1.5};
+    double quat_noise = 0.01;
+    double throw_force = 110.0;          // newtons, for one control step
+    Vec3 aim{0.4, 0.3, 1.0};             // aim = base centre + aim + (U(0, aim_spread), U(0, aim_spread), 0)
+    double aim_spread = 0.1;
+    double catch_bonus = 100.0;          // per held step
+    double hold_weight = 4.0;            // 4 (1 - |hold_target - box|) per held step
+    Vec3 hold_target{0.5, 0.2, 0.2};
+    int hold_steps = 50;
+    static Config read(const Section& env);
+  };
+  struct State {
+    double held = 0;
+  };
+  Config cfg;
+  State s;
+
+  void place(JacoEnv& env) const;
+  void throw_box(JacoEnv& env, Rng& rng) const;
+  void begin() { s = State(); }
+  RuleStep step(const JacoEnv& env);
+};
+
+// Toss: pick the ball up, throw it from below release_height so it peaks at apex_height,
+// and let it come back down within land_tolerance of (land_x, land_y).
+struct TossRule {
+  struct Config {
+    double in_hand = 0.10, in_air = 0.07;
+    Vec3 start{0.4, 0.3, 0.04};
+    double start_noise = 0.04, vel_noise = 0.005;
+    double guide_weight = 100.0;    // 100 (previous - current |hand - ball top|) before the pick
+    double lift_weight = 200.0;     // 200 (min(z, release_height) - best height so far)
+    double release_height = 0.7;
+    double release_bonus = 50.0;
+    double stable_weight = 2.0;     // -2 (|x - land_x| + |y - land_y| - stable_slack) while picked
+    double stable_slack = 0.5;
+    double land_x = 0.4, land_y = 0.3;
+    double apex_height = 2.0;
+    double apex_weight = 50.0;      // 50 (1 - |apex - z| / apex) where the ball stops rising
+    double apex_tolerance = 0.1;
+    double apex_bonus = 50.0;
+    double land_tolerance = 0.1;
+    double success_bonus = 100.0;
+    static Config read(const Section& env);
+  };
+  struct State {
+    double prev_dist = 0, pick_height = 0, picked = 0, released = 0, falling = 0, prev_z = 0;
+    Vec3 ball_top{0, 0, 0};
+  };
+  Config cfg;
+  State s;
+
+  void place(JacoEnv& env, Rng& rng) const;
+  void begin(const JacoEnv& env);
+  RuleStep step(const JacoEnv& env);
+  bool released() const { return s.released != 0; }
+  bool falling() const { return s.falling != 0; }
+};
+
+// Hit: strike the falling ball at hit_height so that it flies to the target on the wall.
+struct HitRule {
+  struct Config {
+    double hit_distance = 0.12, on_ground = 0.07;
+    Vec3 start{0.4, 0.3, 2.0};
+    double start_noise = 0.1, vel_noise = 0.1;
+    double hit_height = 1.0;
+    double hit_weight = 100.0;      // 100 (1 - |z - hit_height|) at the first touch
+    double hit_tolerance = 0.1;     // a touch further from hit_height ends the episode
+    double hit_bonus = 100.0;
+    double vx_cost = 1.0;           // -|vx| after the hit
+    Vec3 target{0.4, 2.0, 1.2};
+    double target_radius = 0.2;
+    double target_bonus = 1200.0;   // the reference's 200 + 1000
+    double miss_weight = 200.0;     // on the ground after a hit: 200 (2 - closest distance) / 2
+    // Not in the reference (0 there): after the hit, approach_weight (previous - current
+    // distance to the target) each step, the potential-based shaping of Ng et al. (1999)
+    // with the distance as potential, which leaves the best policy unchanged.
+    double approach_weight = 0.0;
+    static Config read(const Section& env);
+  };
+  struct State {
+    double hit = 0, closest = 1e9, prev_x = 0, prev_to_target = 0;
+  };
+  Config cfg;
+  State s;
+
+  void place(JacoEnv& env, Rng& rng) const;
+  void begin(const JacoEnv& env);
+  // dt: the control step, for the ball's x velocity by finite differences.
+  RuleStep step(const JacoEnv& env, double dt);
+  bool hit() const { return s.hit != 0; }
+};
+
+// A sub-task: one rule on the arm, ended by its success or failure.
+template <class Rule>
+class JacoSkill : public JacoEnv {
+ public:
+  JacoSkill(const std::string& name, const JacoConfig& c, const std::string& model, bool with_rotation,
+            const typename Rule::Config& rule)
+      : JacoEnv(name, c, model, with_rotation) {
+    rule_.cfg = rule;
+  }
+  const Rule& rule() const { return rule_; }
+
+ protected:
+  void place_task_object() override;
+  void begin_task() override;
+  void after_random_steps() override;
+  StepResult score(const float* action) override;
+  void save_task_state(std::vector<double>& out) const override { append_state(out, rule_.s); }
+  void restore_task_state(const double* in, size_t n) override { read_state(in, n, rule_.s, spec_.name); }
+
+ private:
+  Rule rule_;
+};
+
+using JacoPick = JacoSkill<PickRule>;
+using JacoCatch = JacoSkill<CatchRule>;
+using JacoToss = JacoSkill<TossRule>;
+using JacoHit = JacoSkill<HitRule>;
+
+}  // namespace segue
