@@ -9,6 +9,7 @@ PACKAGES=(
   libopenblas0-openmp     # a fast BLAS for LibTorch (else the reference BLAS is used)
   libeigen3-dev libyaml-cpp-dev libspdlog-dev libgtest-dev
   python3-torch           # to check exported TorchScript from Python
+  python3-matplotlib python3-sklearn   # segue plot, report charts, tools/tsne_actions.py
   libegl-dev libopengl-dev libgl1-mesa-dri   # segue render: EGL + Mesa's software OpenGL, headless
   ffmpeg                  # segue render: encodes the video (without it, PNG frames are written)
 )

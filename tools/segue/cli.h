@@ -55,6 +55,10 @@ int export_main(int argc, char** argv);
 int bench_main(int argc, char** argv);
 int report_main(int argc, char** argv);
 int render_main(int argc, char** argv);
+int plot_main(int argc, char** argv);
+int keys_main(int argc, char** argv);
+// Runs tools/plot.py (matplotlib) with `args`; its exit status (127: no python3).
+int run_plot_tool(const std::string& args);
 
 // Ctrl-C and SIGTERM set the returned flag (the signal number), which a long command polls
 // to checkpoint and stop; a second signal stops at once. uninstall_stop_signals() restores

@@ -21,6 +21,8 @@ const char* kUsage =
     "  report TASK        evaluate methods over seeds; write experiments/results/TASK.{md,json}\n"
     "  export CKPT OUT    write a checkpoint's policy as TorchScript\n"
     "  render POLICY      render one episode of a policy to a video, headless\n"
+    "  plot RUN_DIR       draw a run's learning curves (PNG)\n"
+    "  keys               print every recipe key with its default (docs/recipes.md)\n"
     "  bench              measure physics, rollout and PPO throughput\n\n"
     "Run 'segue COMMAND --help' for a command's flags.\n";
 
@@ -41,6 +43,8 @@ int main(int argc, char** argv) {
     if (cmd == "render") return segue::cli::render_main(argc - 2, argv + 2);
     if (cmd == "bench") return segue::cli::bench_main(argc - 2, argv + 2);
     if (cmd == "report") return segue::cli::report_main(argc - 2, argv + 2);
+    if (cmd == "plot") return segue::cli::plot_main(argc - 2, argv + 2);
+    if (cmd == "keys") return segue::cli::keys_main(argc - 2, argv + 2);
     std::fprintf(stderr, "segue: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
     return 2;
   } catch (const segue::Error& e) {

@@ -19,7 +19,8 @@ const Command kReport{
     "TASK [--methods a,b] [--recipe FILE] [--out DIR]",
     "Evaluates methods of the paper on a composite task over the recipe's evaluation seeds\n"
     "and episodes, and writes DIR/TASK.md (a table in the paper's layout) and DIR/TASK.json\n"
-    "(method -> mean, std, per_seed_means, per_seed_stds, episodes, seeds).",
+    "(method -> mean, std, per_seed_means, per_seed_stds, episodes, seeds), and DIR/TASK.png,\n"
+    "a bar chart of the methods beside the paper's.",
     {"TASK"},
     {{"methods", "a,b", "methods to run (default: every method whose artefacts exist)"},
      {"recipe", "FILE", "composite recipe (default experiments/TASK.yaml)"},
@@ -50,6 +51,9 @@ int report_main(int argc, char** argv) {
   std::string out = args.get("out", std::string(SEGUE_SOURCE_DIR) + "/experiments/results");
   write_results(r, results, skipped, "segue report " + task, out);
   std::printf("wrote %s/%s.md and .json\n", out.c_str(), task.c_str());
+  // The bar chart beside the paper's; a missing matplotlib costs the picture, not the table.
+  if (run_plot_tool("methods '" + out + "/" + task + ".json'") != 0)
+    std::fprintf(stderr, "segue report: no chart drawn (tools/plot.py needs python3-matplotlib)\n");
   return 0;
 }
 

@@ -1,6 +1,8 @@
 // segue run RECIPE: the whole method on a composite task (hrl/pipeline.h), stage by stage.
 #include <spdlog/spdlog.h>
 
+#include <cstdio>
+
 #include "hrl/pipeline.h"
 #include "tools/segue/cli.h"
 
@@ -19,7 +21,8 @@ const Command kRun{
     {"RECIPE"},
     {{"set", "key=value", "override a recipe key (repeatable), e.g. --set switch.attempts=500", true},
      {"threads", "N", "threads stepping environments (overrides the recipe; 0 = all cores)"},
-     {"publish", "DIR", "also write TASK.md and TASK.json to DIR (e.g. experiments/results)"}}};
+     {"publish", "DIR", "also write TASK.md and TASK.json to DIR (e.g. experiments/results)"},
+     {"check", "", "read and check the recipe, then stop"}}};
 
 }  // namespace
 
@@ -29,6 +32,7 @@ int run_main(int argc, char** argv) {
   auto sets = args.all("set");
   if (args.has("threads")) sets.push_back("threads=" + args.get("threads", "0"));
   CompositeRecipe recipe = CompositeRecipe::load(args.positional(0), sets);
+  if (args.has("check")) return std::printf("%s: ok\n", args.positional(0).c_str()) < 0;
   set_torch_threads(1);  // as in training: results do not depend on the thread count
   PipelineOptions o;
   o.threads = resolve_threads(recipe.pipeline.threads);

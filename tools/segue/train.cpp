@@ -33,7 +33,8 @@ const Command kTrain{
     "interruption resumes from the last checkpoint; a finished run is only re-evaluated.",
     {"RECIPE"},
     {{"set", "key=value", "override a recipe key (repeatable), e.g. --set ppo.lr=1e-4", true},
-     {"threads", "N", "threads for environments and LibTorch (overrides the recipe; 0 = all)"}}};
+     {"threads", "N", "threads for environments and LibTorch (overrides the recipe; 0 = all)"},
+     {"check", "", "read and check the recipe (every stage), then stop"}}};
 
 // The end of every run: export the policy, evaluate it on the recipe's eval task, write
 // eval.json.
@@ -148,7 +149,7 @@ SkillRecipe read_skill(const Recipe& recipe, const std::string& default_run_dir)
 }
 
 int train_skill(const Recipe& recipe, const SkillRecipe& s);
-int train_stages(const Recipe& recipe, const std::string& default_run_dir);
+int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool check_only);
 
 }  // namespace
 
@@ -160,8 +161,11 @@ int train_main(int argc, char** argv) {
   if (args.has("threads")) sets.push_back("threads=" + args.get("threads", "0"));
   Recipe recipe = Recipe::load(recipe_path, sets);
   const std::string default_run_dir = "runs/" + std::filesystem::path(recipe_path).stem().string();
-  if (!recipe.stages().empty()) return train_stages(recipe, default_run_dir);
-  return train_skill(recipe, read_skill(recipe, default_run_dir));
+  const bool check = args.has("check");
+  if (!recipe.stages().empty()) return train_stages(recipe, default_run_dir, check);
+  const SkillRecipe s = read_skill(recipe, default_run_dir);
+  if (check) return std::printf("%s: ok\n", recipe_path.c_str()) < 0;
+  return train_skill(recipe, s);
 }
 
 namespace {
@@ -257,7 +261,7 @@ void write_stage_metrics(const std::string& top, const std::vector<Stage>& stage
   write_file_atomic(top + "/metrics.csv", out);
 }
 
-int train_stages(const Recipe& recipe, const std::string& default_run_dir) {
+int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool check_only) {
   const std::vector<Stage> stages = read_stages(recipe);
   const std::string top = recipe.root().get("run_dir", default_run_dir);
   // Stage i's recipe: the file, the stage's keys over it, then where it starts from.
@@ -270,6 +274,7 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir) {
   };
   // Every stage is read and checked before the first step of the first.
   for (size_t i = 0; i < stages.size(); ++i) read_skill(stage_recipe(i, "(the stage before)", 0), top);
+  if (check_only) return std::printf("%s: ok (%zu stages)\n", recipe.file().c_str(), stages.size()) < 0;
   std::filesystem::create_directories(top);
   for (size_t i = 0; i < stages.size(); ++i) {
     const std::string dir = stage_dir(top, i, stages[i]);

@@ -1,0 +1,170 @@
+#!/usr/bin/env python3
+"""Pictures of Segue's runs and results, drawn with matplotlib (PNG).
+
+  tools/plot.py curves RUN_DIR [--out FILE.png]
+      Learning curves from RUN_DIR's CSVs against environment steps: for a skill run
+      (metrics.csv) the episode return, success rate and policy entropy, one colour per
+      stage of a curriculum; for a composite run, each transition's AIRL training
+      (A-B/transition.csv: the share of episodes that complete the interval, D's loss and
+      its accuracies on expert and generator rows). Default output RUN_DIR/curves.png.
+  tools/plot.py methods RESULTS.json [--out FILE.png]
+      The methods' mean success counts (+- std) beside the paper's (tools/paper_results.json),
+      for a table written by `segue report`. Default output RESULTS.png.
+
+Bad input prints one line to stderr and exits 2.
+"""
+import argparse
+import csv
+import glob
+import json
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+METHODS = [("single", "Single"), ("without-tp", "Without TP"), ("tp", "With TP"),
+           ("lee", "Lee et al. 2019"), ("tp+q", "With TP + Q")]
+
+
+class InputError(Exception):
+    pass
+
+
+def read_csv(path):
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+    except OSError as e:
+        raise InputError(f"{path}: cannot read ({e.strerror})")
+    if not rows:
+        raise InputError(f"{path}: no rows")
+    return rows
+
+
+def column(rows, name):
+    out = []
+    for r in rows:
+        try:
+            out.append(float(r[name]))
+        except (KeyError, TypeError, ValueError):
+            out.append(math.nan)
+    return out
+
+
+def skill_curves(run_dir, out):
+    rows = read_csv(os.path.join(run_dir, "metrics.csv"))
+    for needed in ("global_step", "episode_return", "success_rate", "entropy"):
+        if needed not in rows[0]:
+            raise InputError(f"{run_dir}/metrics.csv: no column '{needed}'")
+    stages = []
+    for r in rows:
+        s = r.get("stage", "")
+        if s not in stages:
+            stages.append(s)
+    # A curriculum's stages may restart their step counters: lay them end to end.
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.6))
+    offset = 0.0
+    for s in stages:
+        part = [r for r in rows if r.get("stage", "") == s]
+        steps = column(part, "global_step")
+        if steps and steps[0] <= offset * 0.5 and offset > 0:
+            steps = [x + offset for x in steps]
+        for ax, key, title in zip(axes, ("episode_return", "success_rate", "entropy"),
+                                  ("episode return", "success rate", "policy entropy")):
+            ax.plot(steps, column(part, key), label=s or None, linewidth=1.2)
+            ax.set_title(title)
+            ax.set_xlabel("environment steps")
+        offset = max(offset, max(steps))
+    if any(stages):
+        axes[0].legend(fontsize=7)
+    fig.suptitle(os.path.basename(os.path.normpath(run_dir)))
+    fig.tight_layout()
+    fig.savefig(out, dpi=100)
+
+
+def transition_curves(run_dir, files, out):
+    fig, axes = plt.subplots(1, 3, figsize=(13, 3.6))
+    for path in files:
+        rows = read_csv(path)
+        name = os.path.basename(os.path.dirname(path))
+        steps = column(rows, "global_step")
+        axes[0].plot(steps, column(rows, "interval_completed"), label=name)
+        axes[1].plot(steps, column(rows, "disc_loss"), label=name)
+        axes[2].plot(steps, column(rows, "expert_accuracy"), label=name + " expert")
+        axes[2].plot(steps, column(rows, "generator_accuracy"), "--", label=name + " generator")
+    for ax, title in zip(axes, ("interval completed", "D loss", "D accuracy")):
+        ax.set_title(title)
+        ax.set_xlabel("environment steps")
+        ax.legend(fontsize=7)
+    fig.suptitle(os.path.basename(os.path.normpath(run_dir)) + ": transition policies (AIRL)")
+    fig.tight_layout()
+    fig.savefig(out, dpi=100)
+
+
+def methods_chart(results_path, out):
+    try:
+        ours = json.load(open(results_path))
+    except (OSError, ValueError) as e:
+        raise InputError(f"{results_path}: cannot read a results table ({e})")
+    task = os.path.splitext(os.path.basename(results_path))[0]
+    paper = json.load(open(os.path.join(ROOT, "tools", "paper_results.json")))["tasks"].get(task, {})
+    names = [(k, label) for k, label in METHODS if k in ours or k in paper]
+    if not names:
+        raise InputError(f"{results_path}: no method of the paper in it")
+    fig, ax = plt.subplots(figsize=(8, 3.8))
+    width = 0.38
+    xs = range(len(names))
+    mean = [ours.get(k, {}).get("mean", math.nan) for k, _ in names]
+    std = [ours.get(k, {}).get("std", 0.0) for k, _ in names]
+    ax.bar([x - width / 2 for x in xs], mean, width, yerr=std, capsize=3, label="Segue", color="#0072B2")
+    pm = [paper.get(k, [math.nan, 0])[0] for k, _ in names]
+    ps = [paper.get(k, [math.nan, 0])[1] for k, _ in names]
+    ax.bar([x + width / 2 for x in xs], pm, width, yerr=ps, capsize=3, label="paper", color="#BBBBBB")
+    ax.set_xticks(list(xs))
+    ax.set_xticklabels([label for _, label in names])
+    ax.set_ylabel("success count")
+    ax.set_title(task.replace("_", " "))
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(out, dpi=100)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = ap.add_subparsers(dest="what", required=True)
+    c = sub.add_parser("curves")
+    c.add_argument("run_dir")
+    c.add_argument("--out")
+    m = sub.add_parser("methods")
+    m.add_argument("results")
+    m.add_argument("--out")
+    a = ap.parse_args()
+    try:
+        if a.what == "curves":
+            if not os.path.isdir(a.run_dir):
+                raise InputError(f"{a.run_dir}: no such run directory")
+            out = a.out or os.path.join(a.run_dir, "curves.png")
+            transitions = sorted(glob.glob(os.path.join(a.run_dir, "*", "transition.csv")))
+            if os.path.exists(os.path.join(a.run_dir, "metrics.csv")):
+                skill_curves(a.run_dir, out)
+            elif transitions:
+                transition_curves(a.run_dir, transitions, out)
+            else:
+                raise InputError(f"{a.run_dir}: neither metrics.csv nor */transition.csv")
+        else:
+            out = a.out or os.path.splitext(a.results)[0] + ".png"
+            methods_chart(a.results, out)
+    except InputError as e:
+        print(f"plot.py: {e}", file=sys.stderr)
+        return 2
+    print(f"wrote {out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
