@@ -362,25 +362,52 @@ void PPO::save(const std::string& path, const std::string& note, const ArchiveWr
   ar.write("meta_act_low", torch::tensor(envs_.spec().act_low));
   ar.write("meta_act_high", torch::tensor(envs_.spec().act_high));
   ar.write("meta_note", text_tensor(note));
+  std::vector<double> episodes;
+  std::string rngs;
+  if (envs_.save_episodes(episodes, rngs)) {
+    ar.write("episodes_state", torch::tensor(episodes, torch::kFloat64));
+    ar.write("episodes_rng", text_tensor(rngs));
+    ar.write("episodes_noise", torch::tensor(noise_));
+    ar.write("episodes_noise_age", torch::tensor(std::vector<int64_t>(noise_age_.begin(), noise_age_.end())));
+    ar.write("episodes_running_return", torch::tensor(running_return_, torch::kFloat64));
+  }
   std::ostringstream bytes;
   ar.save_to(bytes);
   write_file_atomic(path, bytes.str());
 }
 
-void PPO::load(const std::string& path, const ArchiveReader& extra) {
+void PPO::load(const std::string& path, const ArchiveReader& extra, bool resume_episodes) {
   torch::serialize::InputArchive ar;
+  torch::Tensor episodes, rngs, noise, noise_age, running_return;
+  bool in_flight = false;
   try {
     ar.load_from(path);
     if (extra) extra(ar);
     read_state(ar, path);
+    in_flight = resume_episodes && ar.try_read("episodes_state", episodes) && ar.try_read("episodes_rng", rngs) &&
+                ar.try_read("episodes_noise", noise) && ar.try_read("episodes_noise_age", noise_age) &&
+                ar.try_read("episodes_running_return", running_return);
   } catch (const c10::Error& e) {
     std::string what = e.what_without_backtrace();
     throw Error(path + ": unreadable checkpoint: " + what.substr(0, what.find('\n')));
   }
-  // Episodes in flight at the interruption are lost; start fresh ones, seeded by position.
+  refresh_inference_copy();
+  if (in_flight && size_t(noise.numel()) == noise_.size()) {
+    try {
+      envs_.restore_episodes(to_doubles(episodes), to_text(rngs));
+      noise_ = to_floats(noise);
+      const std::vector<int64_t> ages = to_int64s(noise_age);
+      noise_age_.assign(ages.begin(), ages.end());
+      running_return_ = to_doubles(running_return);
+      return;
+    } catch (const Error& e) {
+      throw Error(path + ": " + e.what());
+    }
+  }
+  // Episodes in flight cannot be put back (or this continues another run): start fresh
+  // ones, seeded by position.
   envs_.reset(mix_seed(seed_, 0x10000 + iteration_));
   running_return_.assign(envs_.size(), 0.0);
-  refresh_inference_copy();
 }
 
 void PPO::read_state(torch::serialize::InputArchive& ar, const std::string& path) {

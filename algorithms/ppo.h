@@ -109,8 +109,12 @@ class PPO {
   // same file, so the two can never be saved at different iterations.
   using ArchiveWriter = std::function<void(torch::serialize::OutputArchive&)>;
   using ArchiveReader = std::function<void(torch::serialize::InputArchive&)>;
+  // The episodes in flight are saved too where every environment can say its state
+  // (Env::save_episode), and a load with `resume_episodes` puts them back, so a resumed
+  // run is the unbroken one; otherwise, or loading another run's checkpoint to continue
+  // from, the environments start fresh episodes.
   void save(const std::string& path, const std::string& note = "", const ArchiveWriter& extra = {}) const;
-  void load(const std::string& path, const ArchiveReader& extra = {});
+  void load(const std::string& path, const ArchiveReader& extra = {}, bool resume_episodes = true);
   static Policy policy_from_checkpoint(const std::string& path);
 
  private:

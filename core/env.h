@@ -54,6 +54,12 @@ class Env {
   // its episodes from such snapshots of pi_a.
   virtual void save_state(std::vector<double>& out) const = 0;
   virtual void restore_state(const std::vector<double>& state, float* obs) = 0;
+
+  // The episode in flight, for a resume that loses nothing: the snapshot above and the
+  // environment's random stream. False where an environment cannot say (a wrapper that
+  // holds a controller); a resumed run then starts a fresh episode there.
+  virtual bool save_episode(std::vector<double>& state, std::string& rng) const { return false; }
+  virtual void restore_episode(const std::vector<double>& state, const std::string& rng, float* obs) {}
 };
 
 }  // namespace segue

@@ -134,6 +134,17 @@ void MujocoEnv::restore_state(const std::vector<double>& state, float* obs) {
   observe(obs);
 }
 
+bool MujocoEnv::save_episode(std::vector<double>& state, std::string& rng) const {
+  save_state(state);
+  rng = rng_.state();
+  return true;
+}
+
+void MujocoEnv::restore_episode(const std::vector<double>& state, const std::string& rng, float* obs) {
+  restore_state(state, obs);
+  rng_.set_state(rng);
+}
+
 void MujocoEnv::forward(float* obs) {
   mj_forward(model_, data_);
   observe(obs);

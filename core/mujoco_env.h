@@ -25,6 +25,8 @@ class MujocoEnv : public Env {
   StepResult step(const float* action, float* obs) override;
   void save_state(std::vector<double>& out) const override;
   void restore_state(const std::vector<double>& state, float* obs) override;
+  bool save_episode(std::vector<double>& state, std::string& rng) const override;
+  void restore_episode(const std::vector<double>& state, const std::string& rng, float* obs) override;
 
   const mjModel* model() const { return model_; }
   const mjData* data() const { return data_; }

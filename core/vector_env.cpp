@@ -1,6 +1,9 @@
 #include "core/vector_env.h"
 
 #include <algorithm>
+#include <sstream>
+
+#include "core/error.h"
 
 #include "core/rng.h"
 
@@ -39,6 +42,46 @@ VectorEnv::VectorEnv(const Factory& make, int num_envs, int threads) : pool_(thr
       }
     }
   };
+}
+
+// Per environment: the snapshot's length, the snapshot, then the episode's running totals.
+bool VectorEnv::save_episodes(std::vector<double>& numbers, std::string& rngs) const {
+  numbers.clear();
+  rngs.clear();
+  std::vector<double> state;
+  std::string rng;
+  for (int i = 0; i < size(); ++i) {
+    if (!envs_[i]->save_episode(state, rng)) return false;
+    numbers.push_back(double(state.size()));
+    numbers.insert(numbers.end(), state.begin(), state.end());
+    const EpisodeStats& ep = running_[i];
+    numbers.insert(numbers.end(), {ep.ret, double(ep.length), double(ep.success), double(ep.success_count)});
+    numbers.insert(numbers.end(), ep.metric_sums.begin(), ep.metric_sums.end());
+    rngs += rng + "\n";
+  }
+  return true;
+}
+
+void VectorEnv::restore_episodes(const std::vector<double>& numbers, const std::string& rngs) {
+  std::istringstream lines(rngs);
+  size_t k = 0;
+  for (int i = 0; i < size(); ++i) {
+    std::string rng;
+    if (k >= numbers.size() || !std::getline(lines, rng))
+      throw Error("saved episodes are for fewer environments than " + std::to_string(size()));
+    const size_t n = size_t(numbers[k++]);
+    if (k + n + 4 + kMaxMetrics > numbers.size()) throw Error("saved episodes are truncated");
+    envs_[i]->restore_episode(std::vector<double>(numbers.begin() + k, numbers.begin() + k + n), rng,
+                              &obs_[size_t(i) * obs_dim_]);
+    k += n;
+    EpisodeStats& ep = running_[i];
+    ep.ret = numbers[k++];
+    ep.length = int(numbers[k++]);
+    ep.success = numbers[k++] != 0;
+    ep.success_count = int(numbers[k++]);
+    for (auto& m : ep.metric_sums) m = numbers[k++];
+  }
+  if (k != numbers.size()) throw Error("saved episodes are for more environments than " + std::to_string(size()));
 }
 
 void VectorEnv::reset(uint64_t seed) {

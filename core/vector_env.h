@@ -42,6 +42,11 @@ class VectorEnv {
   const std::vector<uint8_t>& truncated() const { return truncated_; }
   const std::vector<StepInfo>& info() const { return info_; }
   std::vector<EpisodeStats>& finished() { return finished_; }
+  // Every environment's episode in flight (Env::save_episode) with its running totals, as
+  // numbers and one line of text per environment; false if any environment cannot.
+  bool save_episodes(std::vector<double>& numbers, std::string& rngs) const;
+  // Puts them back (same number of environments); throws segue::Error on a mismatch.
+  void restore_episodes(const std::vector<double>& numbers, const std::string& rngs);
   ThreadPool& pool() { return pool_; }
 
  private:

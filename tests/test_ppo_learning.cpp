@@ -101,7 +101,7 @@ class PpoCheckpoints : public TempDirTest {
   PpoCheckpoints() : TempDirTest("ppo") {}
 };
 
-TEST_F(PpoCheckpoints, ResumeRestoresEverythingButInFlightEpisodes) {
+TEST_F(PpoCheckpoints, ResumeRestoresEverythingTheEpisodesInFlightIncluded) {
   at::set_num_threads(1);
   ShortWalker s;
   s.cfg.total_steps = 4 * 2048;
@@ -124,9 +124,26 @@ TEST_F(PpoCheckpoints, ResumeRestoresEverythingButInFlightEpisodes) {
   EXPECT_EQ(pa, pb);
   auto pa_params = a.net()->parameters(), pb_params = b.net()->parameters();
   for (size_t i = 0; i < pa_params.size(); ++i) EXPECT_TRUE(torch::equal(pa_params[i], pb_params[i]));
-  // ...and training goes on from there.
-  b.iterate();
-  EXPECT_EQ(b.global_step(), 3 * 2048);
+  // ...and training goes on exactly as the unbroken run: the episodes in flight at the
+  // checkpoint (their states, random streams, running totals and exploration noise) go on.
+  for (int i = 0; i < 2; ++i) {
+    IterationStats sa = a.iterate(), sb = b.iterate();
+    EXPECT_EQ(sa.episodes, sb.episodes) << "iteration " << i;
+    EXPECT_EQ(sa.episode_return, sb.episode_return) << "iteration " << i;
+    EXPECT_EQ(sa.policy_loss, sb.policy_loss) << "iteration " << i;
+    EXPECT_EQ(sa.value_loss, sb.value_loss) << "iteration " << i;
+  }
+  pa_params = a.net()->parameters(), pb_params = b.net()->parameters();
+  for (size_t i = 0; i < pa_params.size(); ++i) EXPECT_TRUE(torch::equal(pa_params[i], pb_params[i]));
+  EXPECT_EQ(b.global_step(), 4 * 2048);
+  // Continuing another run's checkpoint (init_from) starts fresh episodes instead.
+  VectorEnv e3(s.make, s.cfg.num_envs, 1);
+  PPO c(s.cfg, s.spec, e3, 5);
+  c.load(ckpt, {}, /*resume_episodes=*/false);
+  VectorEnv e4(s.make, s.cfg.num_envs, 1);
+  PPO d(s.cfg, s.spec, e4, 5);
+  d.load(ckpt);
+  EXPECT_NE(c.iterate().episode_return, d.iterate().episode_return);
   // A file that is no checkpoint is refused in one line naming it.
   const std::string bad = path("not_a_checkpoint.pt");
   std::ofstream(bad) << "garbage";

@@ -6,6 +6,13 @@
 #include <fstream>
 #include <sstream>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <thread>
+
 #include "core/run_dir.h"
 #include "tests/temp_dir.h"
 
@@ -15,6 +22,31 @@ namespace {
 int run_segue(const std::string& args) {
   std::string cmd = std::string(SEGUE_BINARY) + " " + args + " > /dev/null 2>&1";
   return WEXITSTATUS(std::system(cmd.c_str()));
+}
+
+// Starts `segue train FILE` in the background.
+pid_t start_training(const std::string& file) {
+  pid_t pid = fork();
+  if (pid == 0) {
+    freopen("/dev/null", "w", stdout);
+    freopen("/dev/null", "w", stderr);
+    execl(SEGUE_BINARY, SEGUE_BINARY, "train", file.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+// Every column but the timings.
+void expect_same_rows(const std::vector<std::vector<std::string>>& a, const std::vector<std::vector<std::string>>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t r = 0; r < a.size(); ++r) {
+    ASSERT_EQ(a[r].size(), b[r].size()) << "row " << r;
+    for (size_t c = 0; c < a[r].size(); ++c) {
+      const std::string& name = a[0][c];
+      if (name == "rollout_seconds" || name == "update_seconds" || name == "wall_seconds") continue;
+      EXPECT_EQ(a[r][c], b[r][c]) << "row " << r << " column " << name;
+    }
+  }
 }
 
 std::vector<std::vector<std::string>> csv(const std::string& path) {
@@ -33,11 +65,11 @@ class Stages : public TempDirTest {
  protected:
   Stages() : TempDirTest("stages") {}
   // Two PPO iterations of 1024 steps per stage on a 50-step walk.
-  std::string recipe(const std::string& second) {
-    const std::string file = path("curriculum.yaml");
+  std::string recipe(const std::string& second, const std::string& run = "run") {
+    const std::string file = path(run + ".yaml");
     std::ofstream(file) << "task: walker_forward\n"
                            "threads: 1\n"
-                           "run_dir: " << path("run") << "\n"
+                           "run_dir: " << path(run) << "\n"
                            "checkpoint_every: 1\n"
                            "env: {max_episode_steps: 50, success_steps: 50}\n"
                            "ppo: {total_steps: 2048, num_envs: 4, steps_per_env: 256, minibatch_size: 256, epochs: 2}\n"
@@ -76,12 +108,27 @@ TEST_F(Stages, TwoStagesRunInOrderAndTheSecondContinuesTheFirst) {
   std::filesystem::remove_all(path("run/2-second"));
   ASSERT_EQ(run_segue("train " + recipe(", env: {target_speed: 1.0}")), 0);
   EXPECT_EQ(csv(path("run/1-first/metrics.csv")), first_rows);
-  auto again = csv(path("run/2-second/metrics.csv"));
-  ASSERT_EQ(again.size(), second_rows.size());
-  for (size_t r = 0; r < again.size(); ++r)
-    for (size_t c = 0; c + 1 < again[r].size(); ++c)  // all but wall_seconds
-      if (again[0][c] != "rollout_seconds" && again[0][c] != "update_seconds")
-        EXPECT_EQ(again[r][c], second_rows[r][c]) << "row " << r << " column " << again[0][c];
+  expect_same_rows(csv(path("run/2-second/metrics.csv")), second_rows);
+}
+
+TEST_F(Stages, ARunStoppedInTheSecondStageResumesToTheUnbrokenRunsRows) {
+  // Stage two is 12 iterations, checkpointed after each; the run is stopped (SIGTERM)
+  // as soon as stage two's first checkpoint exists, then rerun to the end.
+  const std::string longer = ", ppo: {total_steps: 12288}";
+  ASSERT_EQ(run_segue("train " + recipe(longer, "unbroken")), 0);
+  const std::string file = recipe(longer, "stopped");
+  pid_t pid = start_training(file);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!std::filesystem::exists(path("stopped/2-second/checkpoint.pt")) && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  const bool stopped_in_stage_two = WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGTERM;
+  EXPECT_TRUE(stopped_in_stage_two) << "status " << status << " (finished before the signal?)";
+  if (stopped_in_stage_two) EXPECT_FALSE(std::filesystem::exists(path("stopped/2-second/eval.json")));
+  ASSERT_EQ(run_segue("train " + file), 0);
+  expect_same_rows(csv(path("stopped/metrics.csv")), csv(path("unbroken/metrics.csv")));
 }
 
 TEST_F(Stages, ContinuingFromThePolicyStartsFreshCounters) {

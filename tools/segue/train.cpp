@@ -325,7 +325,7 @@ int train_skill(const Recipe& recipe, const SkillRecipe& s) {
     const std::string from = repo_path(s.init_from);
     if (!std::filesystem::exists(from))
       throw Error(recipe_path + ": key 'init_from': no such checkpoint '" + s.init_from + "'");
-    ppo.load(from);
+    ppo.load(from, {}, /*resume_episodes=*/false);
     if (!std::isnan(s.init_log_std)) ppo.set_log_std(s.init_log_std);
     if (s.restart_lr_schedule) ppo.restart_lr_schedule();
     spdlog::info("training {} in {} from {} (iteration {}, {} steps) to {} steps", s.task, dir.path(), s.init_from,
