@@ -20,6 +20,7 @@ PickRule::Config PickRule::Config::read(const Section& e) {
   c.hold_weight = e.get("hold_weight", c.hold_weight);
   c.hold_steps = e.get("hold_steps", c.hold_steps);
   c.time_bonus = e.get("time_bonus", c.time_bonus);
+  c.center_weight = e.get("center_weight", c.center_weight);
   if (c.hold_steps < 1) throw e.error("hold_steps", "must be at least 1");
   return c;
 }
@@ -51,7 +52,7 @@ RuleStep PickRule::step(const JacoEnv& env, int t, int max_steps) {
       r.reward += cfg.lift_weight * gain;
       s.pick_height = z;
     }
-    r.reward += cfg.hold_weight * (1 - distance(s.target, env.object_pos()));
+    r.reward += cfg.hold_weight * (1 - distance(s.target, env.object_pos())) - cfg.center_weight * d;
     s.held += 1;
     if (s.held >= cfg.hold_steps) {
       r.success = true;

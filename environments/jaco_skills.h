@@ -27,6 +27,9 @@ struct PickRule {
     double hold_weight = 2.0;    // 2 (1 - |target - box|) on each held step
     int hold_steps = 50;
     double time_bonus = 1.0;     // time_bonus (max_steps - t) at success
+    // Not in the reference (0 there): -center_weight |hand - box| on each held step, for a
+    // grasp deep in the hand rather than at the edge of in_hand, where the box slips out.
+    double center_weight = 0.0;
     static Config read(const Section& env);
   };
   struct State {

@@ -249,6 +249,21 @@ TEST(Jaco, PickRewardsAndSuccessByHand) {
   EXPECT_TRUE(r.terminated);
   EXPECT_TRUE(r.info.success);
   EXPECT_NEAR(got, expected, 1e-3);
+
+  // With center_weight, each held step also costs center_weight |hand - box|.
+  auto centred = make_arm<JacoPick>("jaco_pick", "{init_random_steps: 0, center_weight: 10}");
+  object_contacts_off(*centred);
+  centred->reset(4, obs.data());
+  hold_arm(*centred, q);
+  centred->forward(obs.data());
+  pin(*centred, centred->hand_pos(), obs);
+  const double first = centred->step(zero.data(), obs.data()).reward;
+  env->reset(4, obs.data());
+  hold_arm(*env, q);
+  env->forward(obs.data());
+  pin(*env, env->hand_pos(), obs);
+  const double plain = env->step(zero.data(), obs.data()).reward;
+  EXPECT_NEAR(first, plain - 10 * centred->hand_object_distance(), 1e-9);
 }
 
 TEST(Jaco, PickFailsWhenTheBoxLeavesTheHandAfterThePick) {

@@ -8,6 +8,7 @@
 #include <set>
 
 #include "core/recipe.h"
+#include "tests/cli_run.h"
 #include "tests/temp_dir.h"
 
 namespace segue {
@@ -60,19 +61,7 @@ TEST(Recipe, WrongTypeAndMalformedYaml) {
 }
 
 // The segue binary: each bad input gives exit code 1 and one "error: ..." line.
-struct CliRun {
-  int code;
-  std::string output;
-};
-CliRun run(const std::string& args) {
-  std::string cmd = std::string(SEGUE_BINARY) + " " + args + " 2>&1";
-  FILE* p = popen(cmd.c_str(), "r");
-  std::string out;
-  std::array<char, 512> buf;
-  while (fgets(buf.data(), buf.size(), p)) out += buf.data();
-  int status = pclose(p);
-  return {WEXITSTATUS(status), out};
-}
+CliRun run(const std::string& args) { return run_cli(args); }
 
 class CliErrors : public TempDirTest {
  protected:

@@ -14,15 +14,13 @@
 #include <thread>
 
 #include "core/run_dir.h"
+#include "tests/cli_run.h"
 #include "tests/temp_dir.h"
 
 namespace segue {
 namespace {
 
-int run_segue(const std::string& args) {
-  std::string cmd = std::string(SEGUE_BINARY) + " " + args + " > /dev/null 2>&1";
-  return WEXITSTATUS(std::system(cmd.c_str()));
-}
+int run_segue(const std::string& args) { return run_cli(args).code; }
 
 // Starts `segue train FILE` in the background.
 pid_t start_training(const std::string& file) {
