@@ -11,6 +11,9 @@
       The methods' mean success counts (+- std) beside the paper's (tools/paper_results.json),
       for a table written by `segue report`. Default output RESULTS.png.
 
+  tools/plot.py montage FRAME.png ... --out FILE.png [--titles a,b,...]
+      Frames from `segue render --frames` side by side, one per panel.
+
 Bad input prints one line to stderr and exits 2.
 """
 import argparse
@@ -134,6 +137,23 @@ def methods_chart(results_path, out):
     fig.savefig(out, dpi=100)
 
 
+def montage(frames, titles, out):
+    images = []
+    for f in frames:
+        try:
+            images.append(plt.imread(f))
+        except (OSError, ValueError, SyntaxError) as e:
+            raise InputError(f"{f}: cannot read a picture ({e})")
+    fig, axes = plt.subplots(1, len(images), figsize=(3.2 * len(images), 2.6))
+    for i, (ax, img) in enumerate(zip(axes if len(images) > 1 else [axes], images)):
+        ax.imshow(img)
+        ax.axis("off")
+        if i < len(titles):
+            ax.set_title(titles[i])
+    fig.tight_layout()
+    fig.savefig(out, dpi=100)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     sub = ap.add_subparsers(dest="what", required=True)
@@ -143,6 +163,10 @@ def main():
     m = sub.add_parser("methods")
     m.add_argument("results")
     m.add_argument("--out")
+    g = sub.add_parser("montage")
+    g.add_argument("frames", nargs="+")
+    g.add_argument("--out", required=True)
+    g.add_argument("--titles", default="")
     a = ap.parse_args()
     try:
         if a.what == "curves":
@@ -156,6 +180,9 @@ def main():
                 transition_curves(a.run_dir, transitions, out)
             else:
                 raise InputError(f"{a.run_dir}: neither metrics.csv nor */transition.csv")
+        elif a.what == "montage":
+            out = a.out
+            montage(a.frames, [t for t in a.titles.split(",") if t], out)
         else:
             out = a.out or os.path.splitext(a.results)[0] + ".png"
             methods_chart(a.results, out)
