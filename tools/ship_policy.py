@@ -4,11 +4,7 @@ and records provenance in assets/policies/<group>/manifest.json (recipe, seed, e
 steps, wall time, evaluation, and the policy or checkpoint it started from) from the run
 directory's recipe.yaml and eval.json.
 
-With --eval-seeds S,T the exported policy is also evaluated (`segue eval`, the task's
-reference settings, 50 episodes) on each of those seeds, and the results are recorded
-under "reeval".
-
-usage: tools/ship_policy.py RECIPE RUN_DIR [--group walker] [--eval-seeds 0,1]
+usage: tools/ship_policy.py RECIPE RUN_DIR [--group walker]
 """
 import argparse, json, os, subprocess, sys
 
@@ -17,7 +13,6 @@ ap = argparse.ArgumentParser()
 ap.add_argument("recipe")
 ap.add_argument("run_dir")
 ap.add_argument("--group", default="walker")
-ap.add_argument("--eval-seeds", default="")
 args = ap.parse_args()
 
 evaluation = json.load(open(os.path.join(args.run_dir, "eval.json")))
@@ -42,11 +37,6 @@ manifest[task] = {
     "train_threads": evaluation["threads"],
     "eval": {k: evaluation[k] for k in evaluation if k not in ("env_steps", "wall_seconds", "threads")},
 }
-for seed in [x for x in args.eval_seeds.split(",") if x]:
-    out_json = subprocess.run([os.path.join(root, "build", "segue"), "eval", out, "--task", task, "--episodes", "50",
-                               "--seed", seed, "--json"], check=True, capture_output=True, text=True).stdout
-    result = json.loads(out_json.strip().splitlines()[-1])
-    manifest[task].setdefault("reeval", {})[seed] = {k: result[k] for k in ("success_rate", "return_mean", "episodes")}
 # A curriculum's stages, by name, in order (RUN_DIR/N-NAME holds each).
 if "\nstages:" in resolved:
     import re
