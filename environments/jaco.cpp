@@ -63,21 +63,19 @@ Vec3 JacoEnv::object_velocity() const {
   return {v[0], v[1], v[2]};
 }
 
-void JacoEnv::place_object(const Vec3& pos, double quat_noise, double vel_noise) {
-  double* q = data_->qpos + object_qpos_;
-  for (int k = 0; k < 3; ++k) q[k] = pos[k];
-  q[3] = 1.0;
-  q[4] = q[5] = q[6] = 0.0;
-  for (int k = 3; k < 7; ++k) q[k] += rng_.symmetric(quat_noise);
-  for (int k = 0; k < 6; ++k) data_->qvel[object_dof_ + k] = rng_.symmetric(vel_noise);
-}
-
 void JacoEnv::pin_object(const Vec3& pos) {
   double* q = data_->qpos + object_qpos_;
   for (int k = 0; k < 3; ++k) q[k] = pos[k];
   q[3] = 1.0;
   q[4] = q[5] = q[6] = 0.0;
   std::fill(data_->qvel + object_dof_, data_->qvel + object_dof_ + 6, 0.0);
+}
+
+void JacoEnv::place_object(const Vec3& pos, double quat_noise, double vel_noise) {
+  pin_object(pos);
+  double* q = data_->qpos + object_qpos_;
+  for (int k = 3; k < 7; ++k) q[k] += rng_.symmetric(quat_noise);
+  for (int k = 0; k < 6; ++k) data_->qvel[object_dof_ + k] = rng_.symmetric(vel_noise);
 }
 
 void JacoEnv::throw_object(double force, const Vec3& aim) {
