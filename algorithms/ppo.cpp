@@ -30,7 +30,20 @@ PpoConfig PpoConfig::read(const Section& s, PpoConfig c) {
   c.max_grad_norm = s.get("max_grad_norm", c.max_grad_norm);
   c.normalize_reward = s.get("normalize_reward", c.normalize_reward);
   c.obs_clip = s.get("obs_clip", c.obs_clip);
-  if (c.num_envs <= 0) throw s.error("num_envs", "must be positive");
+  if (c.total_steps <= 0) throw s.error("total_steps", "must be positive, got " + std::to_string(c.total_steps));
+  // Checked before anything is allocated: a typo of 1e9 environments must not exhaust memory.
+  if (c.num_envs <= 0 || c.num_envs > kMaxEnvs)
+    throw s.error("num_envs", "must be in [1, " + std::to_string(kMaxEnvs) + "], got " + std::to_string(c.num_envs));
+  if (c.steps_per_env > kMaxStepsPerEnv)
+    throw s.error("steps_per_env", "must be at most " + std::to_string(kMaxStepsPerEnv));
+  if (c.minibatch_size > int64_t(c.num_envs) * c.steps_per_env)
+    throw s.error("minibatch_size", std::to_string(c.minibatch_size) + " is larger than a rollout (num_envs x steps_per_env = " +
+                                        std::to_string(int64_t(c.num_envs) * c.steps_per_env) + ")");
+  if (!(c.clip > 0)) throw s.error("clip", "must be > 0");
+  if (!(c.vf_coef >= 0)) throw s.error("vf_coef", "must be >= 0");
+  if (!(c.ent_coef >= 0)) throw s.error("ent_coef", "must be >= 0");
+  if (!(c.max_grad_norm > 0)) throw s.error("max_grad_norm", "must be > 0");
+  if (!(c.obs_clip > 0)) throw s.error("obs_clip", "must be > 0");
   if (c.steps_per_env <= 0) throw s.error("steps_per_env", "must be positive");
   if (c.minibatch_size <= 0) throw s.error("minibatch_size", "must be positive");
   if (c.epochs <= 0) throw s.error("epochs", "must be positive");

@@ -18,6 +18,9 @@
 
 namespace segue {
 
+// Limits checked when a recipe is read, before anything is allocated.
+constexpr int kMaxEnvs = 4096, kMaxStepsPerEnv = 100000;
+
 struct PpoConfig {
   int64_t total_steps = 2'000'000;  // environment (control) steps over the whole run
   int num_envs = 16;

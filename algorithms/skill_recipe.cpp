@@ -10,6 +10,7 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   s.task = root.require<std::string>("task");
   s.seed = root.get<uint64_t>("seed", s.seed);
   s.threads = root.get("threads", s.threads);
+  if (s.threads < 0) throw root.error("threads", "must be >= 0 (0: all cores)");
   s.run_dir = root.get("run_dir", default_run_dir);
   s.checkpoint_every = root.get("checkpoint_every", s.checkpoint_every);
   s.init_from = root.get<std::string>("init_from", "");
@@ -29,8 +30,8 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
     throw;
   }
   Section pol = root.sub("policy");
-  s.net.pi_hidden = pol.get("pi_hidden", s.net.pi_hidden);
-  s.net.vf_hidden = pol.get("vf_hidden", s.net.vf_hidden);
+  s.net.pi_hidden = pol.layers("pi_hidden", s.net.pi_hidden);
+  s.net.vf_hidden = pol.layers("vf_hidden", s.net.vf_hidden);
   std::string act = pol.get<std::string>("activation", "tanh");
   try {
     s.net.activation = parse_activation(act);
@@ -49,6 +50,7 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   Section ev = root.sub("eval");
   s.eval_episodes = ev.get("episodes", s.eval_episodes);
   s.eval_seed = ev.get<uint64_t>("seed", s.eval_seed);
+  if (s.eval_episodes <= 0) throw ev.error("episodes", "must be positive");
   s.eval_make_env = s.make_env;
   if (ev.get("reference_task", false))
     s.eval_make_env = reference_task_factory(s.task);

@@ -1,6 +1,7 @@
 #include "core/mujoco_env.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <map>
 #include <mutex>
 
@@ -33,9 +34,24 @@ void take(const double*& in, mjtNum* p, int n) {
   in += n;
 }
 
+// MuJoCo's own handlers write MUJOCO_LOG.TXT and, on an error, wait for Enter on stdin: a
+// run would hang. Errors (e.g. an allocation that fails) become segue::Error instead, and
+// warnings (an unstable simulation, which MuJoCo resets) a line on stderr.
+void on_mujoco_error(const char* msg) { throw Error(std::string("MuJoCo: ") + msg); }
+void on_mujoco_warning(const char* msg) { std::fprintf(stderr, "warning: MuJoCo: %s\n", msg); }
+
 }  // namespace
 
+void install_mujoco_handlers() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    mju_user_error = on_mujoco_error;
+    mju_user_warning = on_mujoco_warning;
+  });
+}
+
 MujocoEnv::MujocoEnv(const std::string& model_file, int frame_skip) : frame_skip_(frame_skip) {
+  install_mujoco_handlers();
   model_ = mj_copyModel(nullptr, cached_model(asset_path(model_file)));
   data_ = mj_makeData(model_);
   spec_.act_dim = model_->nu;

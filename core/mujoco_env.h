@@ -12,6 +12,10 @@
 
 namespace segue {
 
+// Routes MuJoCo's errors into segue::Error and its warnings to stderr (once per process;
+// every MujocoEnv calls it).
+void install_mujoco_handlers();
+
 class MujocoEnv : public Env {
  public:
   MujocoEnv(const std::string& model_file, int frame_skip);

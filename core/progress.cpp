@@ -1,5 +1,7 @@
 #include "core/progress.h"
 
+#include <algorithm>
+
 #include <unistd.h>
 
 #include <cmath>
@@ -28,7 +30,9 @@ void Progress::update(long steps, double ret, double success) {
   last_print_ = now;
   double elapsed = std::chrono::duration<double>(now - t0_).count();
   double sps = elapsed > 0 ? (steps - start_) / elapsed : 0.0;
-  double eta = sps > 0 ? (total_ - steps) / sps : NAN;
+  // The last rollout may overshoot the budget: the line ends at the budget, 100%.
+  steps = std::min(steps, total_);
+  double eta = steps >= total_ ? 0.0 : sps > 0 ? (total_ - steps) / sps : NAN;
   char rate[48];
   if (sps >= 10) std::snprintf(rate, sizeof rate, "%.0f %ss/s", sps, unit_.c_str());
   else std::snprintf(rate, sizeof rate, "%.1f %ss/min", 60 * sps, unit_.c_str());

@@ -77,6 +77,21 @@ void set_path(YAML::Node root, const std::vector<std::string>& parts, const YAML
   }
 }
 
+// yaml-cpp keeps both entries of a key written twice, and lookups find the first: a
+// recipe that sets a key twice is refused instead.
+void refuse_duplicate_keys(const YAML::Node& node, const std::string& prefix, const std::string& file) {
+  if (node.IsMap()) {
+    std::set<std::string> seen;
+    for (const auto& kv : node) {
+      const std::string key = kv.first.Scalar(), path = prefix.empty() ? key : prefix + "." + key;
+      if (!seen.insert(key).second) throw Error(file + ": key '" + path + "' is given twice");
+      refuse_duplicate_keys(kv.second, path, file);
+    }
+  } else if (node.IsSequence()) {
+    for (size_t i = 0; i < node.size(); ++i) refuse_duplicate_keys(node[i], prefix + "." + std::to_string(i), file);
+  }
+}
+
 void collect_leaves(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& out) {
   if (node.IsMap() && node.size() > 0) {
     for (const auto& kv : node)
@@ -111,6 +126,28 @@ std::optional<YAML::Node> Section::lookup(const std::string& full_key) const {
     }
   }
   return node;
+}
+
+std::optional<YAML::Node> Section::lookup_value(const std::string& full_key) const {
+  auto node = lookup(full_key);
+  if (node) return node;
+  // Present but empty (`key:` or `--set key=`)?
+  const auto parts = split_key(full_key);
+  std::string parent;
+  for (size_t i = 0; i + 1 < parts.size(); ++i) parent += (i ? "." : "") + parts[i];
+  auto above = parent.empty() ? std::optional<YAML::Node>(s_->tree) : lookup(parent);
+  if (above && above->IsMap()) {
+    YAML::Node child = (*above)[parts.back()];
+    if (child.IsDefined() && child.IsNull()) throw Error(s_->file + ": key '" + full_key + "' has no value");
+  }
+  return std::nullopt;
+}
+
+std::vector<int> Section::layers(const std::string& key, const std::vector<int>& fallback) const {
+  std::vector<int> widths = get(key, fallback);
+  for (int w : widths)
+    if (w <= 0) throw error(key, "layer widths must be positive, got " + std::to_string(w));
+  return widths;
 }
 
 void Section::record(const std::string& full_key, const YAML::Node& value) const {
@@ -171,12 +208,15 @@ Recipe Recipe::parse(const std::string& text, const std::string& name,
   }
   if (s->tree.IsNull()) s->tree = YAML::Node(YAML::NodeType::Map);
   if (!s->tree.IsMap()) throw Error(name + ": a recipe must be a mapping of keys");
+  refuse_duplicate_keys(s->tree, "", name);
   s->resolved = YAML::Node(YAML::NodeType::Map);
   for (const auto& o : overrides) {
     auto eq = o.find('=');
     if (eq == std::string::npos || eq == 0)
       throw Error("--set " + o + ": expected key=value");
     std::string key = o.substr(0, eq);
+    if (key.front() == '.' || key.back() == '.' || key.find("..") != std::string::npos)
+      throw Error("--set " + o + ": '" + key + "' is not a key (parts are separated by single dots)");
     YAML::Node value;
     try {
       value = YAML::Load(o.substr(eq + 1));

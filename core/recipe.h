@@ -6,6 +6,7 @@
 // directory records.
 #include <yaml-cpp/yaml.h>
 
+#include <cmath>
 #include <memory>
 #include <optional>
 #include <set>
@@ -35,6 +36,8 @@ class Section {
   const std::string& path() const { return prefix_; }
   // "FILE: key 'a.b': msg" — the one-line error for a bad value found after reading.
   Error error(const std::string& key, const std::string& msg) const;
+  // A network's hidden layer widths (`pi_hidden: [64, 64]`): a list of positive integers.
+  std::vector<int> layers(const std::string& key, const std::vector<int>& fallback) const;
 
  private:
   friend class Recipe;
@@ -43,7 +46,10 @@ class Section {
   std::string full(const std::string& key) const {
     return prefix_.empty() ? key : key.empty() ? prefix_ : prefix_ + "." + key;
   }
+  // The value at full_key, if present; a key written with no value is refused (a
+  // `--set ppo.total_steps=` must not silently become the default).
   std::optional<YAML::Node> lookup(const std::string& full_key) const;
+  std::optional<YAML::Node> lookup_value(const std::string& full_key) const;
   template <class T>
   T convert(const YAML::Node& node, const std::string& full_key) const;
   void record(const std::string& full_key, const YAML::Node& value) const;
@@ -87,7 +93,7 @@ struct Section::State {
 template <class T>
 T Section::get(const std::string& key, const T& fallback) const {
   std::string k = full(key);
-  auto node = lookup(k);
+  auto node = lookup_value(k);
   T value = node ? convert<T>(*node, k) : fallback;
   if (!node) s_->defaulted.insert(k);
   record(k, YAML::Node(value));
@@ -97,7 +103,7 @@ T Section::get(const std::string& key, const T& fallback) const {
 template <class T>
 T Section::require(const std::string& key) const {
   std::string k = full(key);
-  auto node = lookup(k);
+  auto node = lookup_value(k);
   if (!node) throw Error(s_->file + ": missing required key '" + k + "'");
   T value = convert<T>(*node, k);
   record(k, YAML::Node(value));
@@ -123,7 +129,17 @@ T Section::convert(const YAML::Node& node, const std::string& k) const {
     if (d != static_cast<double>(static_cast<T>(d))) throw bad();
     return static_cast<T>(d);
   } else {
-    try { return node.as<T>(); } catch (const YAML::Exception&) { throw bad(); }
+    T value;
+    try { value = node.as<T>(); } catch (const YAML::Exception&) { throw bad(); }
+    // NaN and infinity pass every range check (NaN compares false): refuse them here.
+    if constexpr (std::is_floating_point_v<T>) {
+      if (!std::isfinite(value)) throw Error(s_->file + ": key '" + k + "' must be a finite number, got " + node.Scalar());
+    } else if constexpr (std::is_same_v<T, std::vector<double>>) {
+      for (size_t i = 0; i < value.size(); ++i)
+        if (!std::isfinite(value[i]))
+          throw Error(s_->file + ": key '" + k + "' must hold finite numbers, got " + node[i].Scalar());
+    }
+    return value;
   }
 }
 

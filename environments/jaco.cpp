@@ -44,6 +44,12 @@ JacoEnv::JacoEnv(const std::string& name, const JacoConfig& config, const std::s
   if (base_geom_ < 0 || *std::min_element(hand_geoms_.begin(), hand_geoms_.end()) < 0)
     throw Error(model_file + ": the arm needs geoms jaco_link_base, jaco_link_hand and jaco_link_finger_1..3");
   random_action_.resize(model_->nu);
+  spec_.feature_names = {"steps", "object_z"};
+}
+
+void JacoEnv::features(double* out) const {
+  out[0] = t_;
+  out[1] = object_z();
 }
 
 Vec3 JacoEnv::hand_pos() const {

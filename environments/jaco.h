@@ -57,6 +57,10 @@ class JacoEnv : public MujocoEnv {
   // Holds the object where it is, at rest (Repetitive catching pins the next box).
   void pin_object(const Vec3& pos);
 
+  // Features (what transition intervals and expert windows are written in): steps (since
+  // the episode start), object_z; a task appends its own.
+  void features(double* out) const override;
+
  protected:
   void reset_task() final;
   StepResult evaluate(const float* action) final;
@@ -83,19 +87,23 @@ class JacoEnv : public MujocoEnv {
   std::vector<float> random_action_;
 };
 
-// A task's bookkeeping as a struct of doubles, so snapshots can copy it whole.
+// A task's bookkeeping as structs of doubles, so snapshots can copy them whole.
 template <class State>
-void append_state(std::vector<double>& out, const State& s) {
+constexpr size_t state_size() {
   static_assert(sizeof(State) % sizeof(double) == 0, "task state must be doubles only");
-  const double* p = reinterpret_cast<const double*>(&s);
-  out.insert(out.end(), p, p + sizeof(State) / sizeof(double));
+  return sizeof(State) / sizeof(double);
 }
-template <class State>
-void read_state(const double* in, size_t n, State& s, const std::string& task) {
-  if (n != sizeof(State) / sizeof(double))
-    throw Error(task + ": a saved state with " + std::to_string(n) + " task numbers, expected " +
-                std::to_string(sizeof(State) / sizeof(double)));
-  std::copy(in, in + n, reinterpret_cast<double*>(&s));
+template <class... State>
+void append_state(std::vector<double>& out, const State&... s) {
+  (out.insert(out.end(), reinterpret_cast<const double*>(&s), reinterpret_cast<const double*>(&s) + state_size<State>()),
+   ...);
+}
+template <class... State>
+void read_state(const double* in, size_t n, const std::string& task, State&... s) {
+  const size_t want = (state_size<State>() + ...);
+  if (n != want)
+    throw Error(task + ": a saved state with " + std::to_string(n) + " task numbers, expected " + std::to_string(want));
+  ((std::copy(in, in + state_size<State>(), reinterpret_cast<double*>(&s)), in += state_size<State>()), ...);
 }
 
 }  // namespace segue

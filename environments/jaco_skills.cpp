@@ -64,8 +64,9 @@ RuleStep PickRule::step(const JacoEnv& env, int t, int max_steps) {
   return r;
 }
 
-CatchRule::Config CatchRule::Config::read(const Section& e) {
+CatchRule::Config CatchRule::Config::read(const Section& e, const Vec3& hold_target) {
   Config c;
+  c.hold_target = hold_target;
   c.in_hand = e.get("in_hand", c.in_hand);
   c.in_air = e.get("in_air", c.in_air);
   c.on_ground = e.get("on_ground", c.on_ground);
@@ -178,7 +179,7 @@ RuleStep TossRule::step(const JacoEnv& env) {
       r.failed = true;
     }
   }
-  if (s.falling && z < cfg.release_height) {
+  if (judge_landing && s.falling && z < cfg.release_height) {
     if (std::abs(ball[0] - cfg.land_x) < cfg.land_tolerance && std::abs(ball[1] - cfg.land_y) < cfg.land_tolerance) {
       r.reward += cfg.success_bonus;
       r.success = true;

@@ -2,6 +2,8 @@
 // The arm's four sub-tasks (../shared/spec/jaco.md §3): pick, catch, toss, hit. Each rule is
 // a small struct (its settings, its bookkeeping, one step of scoring) so that the composite
 // tasks, which run the same rules in sequence or repeatedly, reuse them unchanged.
+#include <type_traits>
+
 #include "environments/jaco.h"
 
 namespace segue {
@@ -58,7 +60,7 @@ struct CatchRule {
     double hold_weight = 4.0;            // 4 (1 - |hold_target - box|) per held step
     Vec3 hold_target{0.5, 0.2, 0.2};
     int hold_steps = 50;
-    static Config read(const Section& env);
+    static Config read(const Section& env, const Vec3& hold_target = {0.5, 0.2, 0.2});
   };
   struct State {
     double held = 0;
@@ -67,6 +69,8 @@ struct CatchRule {
   State s;
 
   void place(JacoEnv& env) const;
+  // Repetitive catching holds the next box at the start, at rest, until it is thrown.
+  void pin_at_start(JacoEnv& env) const { env.pin_object(cfg.start); }
   void throw_box(JacoEnv& env, Rng& rng) const;
   void begin() { s = State(); }
   RuleStep step(const JacoEnv& env);
@@ -100,6 +104,9 @@ struct TossRule {
   };
   Config cfg;
   State s;
+  // Serve judges the toss when the ball comes down to the hit instead (jaco.md §4): the
+  // landing is then not scored.
+  bool judge_landing = true;
 
   void place(JacoEnv& env, Rng& rng) const;
   void begin(const JacoEnv& env);
@@ -150,8 +157,13 @@ class JacoSkill : public JacoEnv {
             const typename Rule::Config& rule)
       : JacoEnv(name, c, model, with_rotation) {
     rule_.cfg = rule;
+    if constexpr (std::is_same_v<Rule, HitRule>) spec_.feature_names.push_back("hit");  // 0 / 1
   }
   const Rule& rule() const { return rule_; }
+  void features(double* out) const override {
+    JacoEnv::features(out);
+    if constexpr (std::is_same_v<Rule, HitRule>) out[2] = rule_.s.hit;
+  }
 
  protected:
   void place_task_object() override;
@@ -159,7 +171,7 @@ class JacoSkill : public JacoEnv {
   void after_random_steps() override;
   StepResult score(const float* action) override;
   void save_task_state(std::vector<double>& out) const override { append_state(out, rule_.s); }
-  void restore_task_state(const double* in, size_t n) override { read_state(in, n, rule_.s, spec_.name); }
+  void restore_task_state(const double* in, size_t n) override { read_state(in, n, spec_.name, rule_.s); }
 
  private:
   Rule rule_;

@@ -4,6 +4,7 @@
 #include <map>
 
 #include "environments/jaco_skills.h"
+#include "environments/jaco_tasks.h"
 #include "environments/walker.h"
 #include "environments/walker_course.h"
 #include "environments/walker_obstacles.h"
@@ -160,6 +161,56 @@ Builder jaco_skill(const std::string& model, bool with_rotation, double init_noi
   };
 }
 
+// The arm's composite tasks (jaco.md §4): start noise 0.005, no random steps.
+JacoConfig jaco_composite(const Section& env, int max_steps, int random_steps = 0) {
+  JacoConfig d;
+  d.init_noise = 0.005;
+  d.init_random_steps = random_steps;
+  d.max_episode_steps = max_steps;
+  return JacoConfig::read(env, d);
+}
+
+int read_successes(const Section& env) {
+  const int n = env.get("successes", 5);
+  if (n < 1) throw env.error("successes", "must be at least 1");
+  return n;
+}
+
+Factory repetitive_picking(const std::string& name, const Section& env) {
+  JacoConfig c = jaco_composite(env, 1000);
+  JacoRepetitivePick::Config k;
+  k.successes = read_successes(env);
+  k.pick_steps = env.get("pick_steps", k.pick_steps);
+  if (k.pick_steps < 1) throw env.error("pick_steps", "must be at least 1");
+  k.pick = PickRule::Config::read(env);
+  return [=] { return std::make_unique<JacoRepetitivePick>(name, c, k); };
+}
+
+Factory repetitive_catching(const std::string& name, const Section& env) {
+  // The first box falls for 10 random steps before its throw, as in Catch (the reference: 0).
+  JacoConfig c = jaco_composite(env, 1000, 10);
+  JacoRepetitiveCatch::Config k;
+  k.successes = read_successes(env);
+  k.pin_steps = env.get("pin_steps", k.pin_steps);
+  k.fall_steps = env.get("fall_steps", k.fall_steps);
+  if (k.pin_steps < 0) throw env.error("pin_steps", "must be >= 0");
+  if (k.fall_steps < 0) throw env.error("fall_steps", "must be >= 0");
+  k.catching = CatchRule::Config::read(env, /*hold_target=*/{0.0, 0.2, 0.2});  // KeepCatch's, not Catch's
+  return [=] { return std::make_unique<JacoRepetitiveCatch>(name, c, k); };
+}
+
+// Serve's `start`, `start_noise` and `vel_noise` are the toss's (the ball starts on the ground).
+Factory serve(const std::string& name, const Section& env) {
+  JacoConfig c = jaco_composite(env, 300);
+  JacoServe::Config k;
+  k.judge_height = env.get("judge_height", k.judge_height);
+  k.toss_bonus = env.get("toss_bonus", k.toss_bonus);
+  k.toss_tolerance = env.get("toss_tolerance", k.toss_tolerance);
+  k.toss = TossRule::Config::read(env);
+  k.hit = HitRule::Config::read(env);
+  return [=] { return std::make_unique<JacoServe>(name, c, k); };
+}
+
 const std::map<std::string, Builder>& builders() {
   static const std::map<std::string, Builder> table = {
       {"walker_forward", walker_walk(+1.0)},
@@ -175,6 +226,9 @@ const std::map<std::string, Builder>& builders() {
       {"jaco_catch", jaco_skill<CatchRule>("jaco/jaco_box.xml", true, 0.01, 10)},
       {"jaco_toss", jaco_skill<TossRule>("jaco/jaco_ball.xml", false, 0.005, 0)},
       {"jaco_hit", jaco_skill<HitRule>("jaco/jaco_ball.xml", false, 0.005, 10)},
+      {"repetitive_picking", repetitive_picking},
+      {"repetitive_catching", repetitive_catching},
+      {"serve", serve},
   };
   return table;
 }

@@ -21,7 +21,7 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
   for (const auto& a : trained) any_q |= bool(a.q);
   TransitionController controller(r.skills, r.meta, trained, any_q ? SwitchRule::QNetwork : SwitchRule::IntervalEnd);
   std::vector<float> obs(spec.obs_dim), act(spec.act_dim);
-  std::vector<double> f(spec.feature_names.size()), state;
+  std::vector<double> state;
   StartStates out;
   out.source = r.transition_source(transition);
   out.obs_dim = spec.obs_dim;
@@ -34,11 +34,9 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
       // may be driven by a transition policy into a rather than by pi_a itself: on Patrol,
       // balance->walk begins at the very step walk->balance's interval ends, so balance
       // never runs alone and "pi_a in control" would find no state at all.
-      env->features(f.data());
-      const bool begins = controller.skill() == tr.from && r.meta.active_transition(tr.from, f.data()) == transition;
-      if (begins) env->save_state(state);
+      env->save_state(state);
       controller.act(*env, obs.data(), act.data());
-      if (begins && controller.skill() == tr.to) {  // the hand-over to b happened at this state
+      if (controller.entered() == transition) {  // the hand-over to b happened at this state
         out.state_dim = int(state.size());
         out.states.insert(out.states.end(), state.begin(), state.end());
         out.obs.insert(out.obs.end(), obs.begin(), obs.end());  // act() leaves obs as it was
@@ -98,8 +96,9 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
     int successes = 0, at_entry = 0;  // the task's success count, now and on entering
     // With expert_successful a window is seen to its end, then pi_b runs on to its success.
     for (int t = 0; !done && (tr.expert_successful || out.size() + window.size() < count); ++t) {
-      if (!own_task) env->features(f.data());
-      bool inside = own_task ? t < tr.expert_steps : MetaController::holds(tr.expert_when, f.data());
+      env->features(f.data());
+      const bool inside = (!own_task || tr.expert_steps == 0 || t < tr.expert_steps) &&
+                          MetaController::holds(tr.expert_when, f.data());
       past |= entered && !inside;  // one window per episode
       if (past && (succeeded || !tr.expert_successful)) break;
       if (!entered && inside) at_entry = successes;

@@ -26,7 +26,8 @@ CompositeRecipe CompositeRecipe::load(const std::string& file, const std::vector
   }
   c.spec = c.make_env()->spec();
   c.skills = read_skills(root.sub("skills"), c.spec);
-  c.meta = MetaController(root, c.skills, c.spec.feature_names);
+  c.meta = MetaController(root, c.skills, c.spec.feature_names,
+                          [](const std::string& task) { return reference_task_factory(task)()->spec().feature_names; });
   const auto items = root.items("transitions");
   for (size_t t = 0; t < c.meta.transitions().size(); ++t) {
     const Transition& tr = c.meta.transitions()[t];
@@ -48,9 +49,28 @@ CompositeRecipe CompositeRecipe::load(const std::string& file, const std::vector
   if (methods.has("single")) c.single_policy = methods.sub("single").require<std::string>("policy");
   c.transitions_dir = methods.get<std::string>("transitions", "");
   c.pipeline = PipelineConfig::read(root, c.task, c.spec.obs_dim);
+  if (c.pipeline.transition.init_from_next)  // pi_ab starts as a copy of pi_b: the same layers
+    for (const Transition& tr : c.meta.transitions()) {
+      const Skill& b = c.skills[tr.to];
+      const auto& w = b.policy.mlp().weights();
+      std::vector<int> hidden;
+      for (size_t l = 0; l + 1 < w.size(); ++l) hidden.push_back(int(w[l].rows()));
+      if (hidden != c.pipeline.transition.net.pi_hidden) {
+        auto list = [](const std::vector<int>& v) {
+          std::string out;
+          for (int x : v) out += (out.empty() ? "" : ", ") + std::to_string(x);
+          return "[" + out + "]";
+        };
+        throw root.sub("transition").sub("policy").error(
+            "pi_hidden", list(c.pipeline.transition.net.pi_hidden) + ", but pi_ab starts as skill '" + b.name +
+                             "' (init_from_next), whose hidden layers are " + list(hidden));
+      }
+    }
   Section ev = root.sub("eval");
   c.eval_episodes = ev.get("episodes", c.eval_episodes);
   c.eval_seeds = ev.get("seeds", c.eval_seeds);
+  if (c.eval_episodes <= 0) throw ev.error("episodes", "must be positive");
+  if (c.eval_seeds.empty()) throw ev.error("seeds", "lists no seed");
   recipe.reject_unknown();
   c.resolved = recipe.resolved_yaml();
   c.defaulted = recipe.defaulted_keys();

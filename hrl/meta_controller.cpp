@@ -38,7 +38,8 @@ std::vector<Condition> read_when(const Section& s, const std::vector<std::string
 }
 
 MetaController::MetaController(const Section& root, const std::vector<Skill>& skills,
-                               const std::vector<std::string>& features) {
+                               const std::vector<std::string>& features,
+                               const std::function<std::vector<std::string>(const std::string&)>& task_features) {
   for (const Section& rule : root.items("start"))
     start_.push_back({find_skill(rule, "skill", skills), read_when(rule, features)});
   if (start_.empty()) throw root.error("start", "lists no start skill");
@@ -51,6 +52,15 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
     if (t.has("start_states") && tr.start_states <= 0) throw t.error("start_states", "must be positive");
     tr.max_steps = t.get<int>("max_steps", 0);
     if (t.has("max_steps") && tr.max_steps <= 0) throw t.error("max_steps", "must be positive");
+    if (t.has("training")) {
+      Section w = t.sub("training");
+      if (!w.has("when") && !w.has("max_steps")) throw t.error("training", "give its window: when and/or max_steps");
+      if (w.has("when")) tr.training_when = read_when(w, features);
+      tr.training_max_steps = w.get<int>("max_steps", 0);
+      if (w.has("max_steps") && tr.training_max_steps <= 0) throw w.error("max_steps", "must be positive");
+    } else {
+      tr.training_when = tr.when, tr.training_max_steps = tr.max_steps;
+    }
     if (t.has("expert")) {
       Section e = t.sub("expert");
       tr.expert_task = e.get<std::string>("task", "");
@@ -59,18 +69,37 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
       if (tr.expert_task.empty()) {
         if (e.has("when")) tr.expert_when = read_when(e, features);  // else the interval
       } else {
-        if (e.has("when")) throw e.error("when", "applies to this task's features; with expert.task give expert.steps");
         if (tr.expert_after_handover) throw e.error("after_handover", "S_a's states are this task's; not with expert.task");
-        tr.expert_steps = e.require<int>("steps");
-        if (tr.expert_steps <= 0) throw e.error("steps", "must be positive");
+        if (!e.has("steps") && !e.has("when"))
+          throw e.error("task", "give pi_b's window on it: expert.steps and/or expert.when (over its features)");
+        std::vector<std::string> own;
+        try {
+          own = task_features ? task_features(tr.expert_task) : std::vector<std::string>{};
+        } catch (const Error& err) {
+          throw e.error("task", err.what());
+        }
+        tr.expert_when = read_when(e, own);
+        tr.expert_steps = e.get<int>("steps", 0);
+        if (e.has("steps") && tr.expert_steps <= 0) throw e.error("steps", "must be positive");
       }
     }
+    for (const Transition& other : transitions_)
+      if (other.from == tr.from && other.to == tr.to)
+        throw t.error("to", "a second transition " + skills[tr.from].name + " -> " + skills[tr.to].name +
+                                " (each has one interval and one folder of artefacts)");
     transitions_.push_back(tr);
   }
+  if (transitions_.empty()) throw root.error("transitions", "lists no transition");
 }
 
 bool Transition::running(const double* features, int steps) const {
   return !capped(steps) && MetaController::holds(when, features);
+}
+
+Transition Transition::training_window() const {
+  Transition w = *this;
+  w.when = training_when, w.max_steps = training_max_steps;
+  return w;
 }
 
 bool MetaController::holds(const std::vector<Condition>& when, const double* f) {
@@ -85,9 +114,10 @@ int MetaController::start_skill(const double* f) const {
   return start_.front().first;
 }
 
-int MetaController::active_transition(int skill, const double* f) const {
+int MetaController::active_transition(int skill, const double* f, const std::vector<char>* taken) const {
   for (size_t i = 0; i < transitions_.size(); ++i)
-    if (transitions_[i].from == skill && holds(transitions_[i].when, f)) return static_cast<int>(i);
+    if (transitions_[i].from == skill && !(taken && (*taken)[i]) && holds(transitions_[i].when, f))
+      return static_cast<int>(i);
   return -1;
 }
 

@@ -11,6 +11,7 @@
 // `when` maps features to closed ranges [lo, hi] (a single number means equality); all
 // must hold. A transition a->b is "in its interval" while its conditions hold and the
 // current skill is a. Nothing here knows any particular task.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -31,8 +32,10 @@ struct Transition {
   // start, while these hold (`expert: {when: ...}`; by default the interval itself).
   std::vector<Condition> expert_when;
   // Or, where pi_b alone never reaches the interval in this task (the crawl falls in the
-  // open before the first ceiling): the first expert_steps steps of pi_b's episodes on its
-  // own sub-task (`expert: {task: walker_crawl, steps: 150}`).
+  // open before the first ceiling; the hit never runs alone in Serve): pi_b's episodes on
+  // its own sub-task, their first expert_steps steps (`expert: {task: walker_crawl, steps:
+  // 150}`) and/or while expert_when holds over that task's features (`expert: {task:
+  // jaco_hit, when: {steps: [21, 200], object_z: [0.9, 10], hit: 0}}`).
   std::string expert_task;
   int expert_steps = 0;
   // Keep only the windows after which pi_b goes on to succeed (`expert: {successful: true}`):
@@ -56,21 +59,36 @@ struct Transition {
   bool capped(int steps) const { return max_steps > 0 && steps >= max_steps; }
   // Whether a transition policy that has taken `steps` steps in the interval keeps control.
   bool running(const double* features, int steps) const;
+  // The window pi_ab's own training episodes run in (`training: {when: ..., max_steps: N}`;
+  // by default the interval): episodes start at S_a, where the interval begins, and may run
+  // on past where the switch must hand over, so that pi_ab does not learn to hand over at
+  // the very edge of its own episodes (the reference trains Hurdle's walk->jump from 4 to
+  // 2 m before the curb and evaluates it from 4 to 3 m; pick->pick until the box lifts off,
+  // where the switch is forced after 30 steps).
+  std::vector<Condition> training_when;
+  int training_max_steps = 0;
+  // This transition with its training window as the interval.
+  Transition training_window() const;
 };
 
 // Reads s's `when:` mapping over these feature names (none: always holds); an unknown
 // feature or a bad range is a one-line error naming the key.
 std::vector<Condition> read_when(const Section& s, const std::vector<std::string>& features);
 
+// A transition's interval is entered once: after pi_ab (or pi_b) has taken it, it is entered
+// again only once its conditions have stopped holding, so that a skill may hand over to
+// itself (Repetitive picking's pick->pick) without entering the interval it just left.
 class MetaController {
  public:
   MetaController() = default;
-  MetaController(const Section& root, const std::vector<Skill>& skills,
-                 const std::vector<std::string>& feature_names);
+  // task_features: the feature names of a sub-task named by `expert.task`.
+  MetaController(const Section& root, const std::vector<Skill>& skills, const std::vector<std::string>& feature_names,
+                 const std::function<std::vector<std::string>(const std::string&)>& task_features = nullptr);
   // The first start rule that holds (or the first rule when none does).
   int start_skill(const double* features) const;
-  // The index of the transition out of `skill` whose interval holds now, or -1.
-  int active_transition(int skill, const double* features) const;
+  // The index of the transition out of `skill` whose interval holds now, or -1; with
+  // `taken`, transitions marked there (entered, and their interval not yet left) are passed over.
+  int active_transition(int skill, const double* features, const std::vector<char>* taken = nullptr) const;
   const std::vector<Transition>& transitions() const { return transitions_; }
   static bool holds(const std::vector<Condition>& when, const double* f);
 

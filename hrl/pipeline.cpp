@@ -85,9 +85,11 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
                    c.demonstrations);
     else if (tr.expert_task.empty())
       spdlog::info("  collecting T_b: {} steps of pi_b in its own interval", c.demonstrations);
-    else
+    else if (tr.expert_steps > 0)
       spdlog::info("  collecting T_b: {} steps of pi_b, its first {} of each episode on {}", c.demonstrations,
                    tr.expert_steps, tr.expert_task);
+    else
+      spdlog::info("  collecting T_b: {} steps of pi_b in its window on {}", c.demonstrations, tr.expert_task);
     // After the hand-over: from S_a's states less those held out for the switch margin.
     StartStates handovers;
     if (tr.expert_after_handover) {
@@ -143,7 +145,7 @@ int train_transition(const CompositeRecipe& r, int t, const std::string& dir, co
   const Skill& b = r.skills[tr.to];
   StartStates starts = starts_of(r, t, dir);
   VectorEnv envs(
-      [&] { return std::make_unique<TransitionEnv>(r.make_env(), starts, tr, b.obs_begin, b.obs_end); },
+      [&] { return std::make_unique<TransitionEnv>(r.make_env(), starts, tr.training_window(), b.obs_begin, b.obs_end); },
       cfg.ppo.num_envs, o.threads);
   TransitionPolicyTrainer trainer(cfg, envs, demonstrations_of(r, t, dir), b.policy,
                                   mix_seed(r.pipeline.seed, 100 + t));

@@ -21,15 +21,15 @@ TransitionPolicyConfig TransitionPolicyConfig::read(const Section& s, int obs_di
   c.ppo.minibatch_size = 512;
   c.ppo = PpoConfig::read(s.sub("ppo"), c.ppo);
   Section pol = s.sub("policy");
-  c.net.pi_hidden = pol.get("pi_hidden", c.net.pi_hidden);
-  c.net.vf_hidden = pol.get("vf_hidden", std::vector<int>{64, 64});
+  c.net.pi_hidden = pol.layers("pi_hidden", c.net.pi_hidden);
+  c.net.vf_hidden = pol.layers("vf_hidden", std::vector<int>{64, 64});
   c.net.init_log_std = pol.get("init_log_std", -1.0);
   c.init_from_next = s.get("init_from_next", c.init_from_next);
   c.reward = s.get("reward", c.reward);
   if (c.reward != "airl" && c.reward != "airl_absorbing" && c.reward != "airl_nonnegative")
     throw s.error("reward", "must be airl (Eq. 3), airl_absorbing or airl_nonnegative (-log(1 - D))");
   Section d = s.sub("discriminator");
-  c.discriminator.hidden = d.get("hidden", c.discriminator.hidden);
+  c.discriminator.hidden = d.layers("hidden", c.discriminator.hidden);
   c.disc_lr = d.get("lr", c.disc_lr);
   c.disc_batch = d.get("batch", c.disc_batch);
   c.disc_steps = d.get("steps", c.disc_steps);
@@ -52,7 +52,7 @@ ActorCriticSpec TransitionPolicyConfig::network(const EnvSpec& env, const Policy
 
 SwitchConfig SwitchConfig::read(const Section& s, int obs_dim) {
   SwitchConfig c;
-  c.net.hidden = s.get("hidden", c.net.hidden);
+  c.net.hidden = s.layers("hidden", c.net.hidden);
   c.net.gamma = s.get("gamma", c.net.gamma);
   c.lr = s.get("lr", c.lr);
   c.batch = s.get("batch", c.batch);
@@ -92,7 +92,7 @@ SwitchConfig SwitchConfig::read(const Section& s, int obs_dim) {
 LeeConfig LeeConfig::read(const Section& s) {
   LeeConfig c;
   c.enabled = s.get("enabled", c.enabled);
-  c.hidden = s.get("hidden", c.hidden);
+  c.hidden = s.layers("hidden", c.hidden);
   c.lr = s.get("lr", c.lr);
   c.batch = s.get("batch", c.batch);
   c.steps = s.get("steps", c.steps);
@@ -110,6 +110,7 @@ PipelineConfig PipelineConfig::read(const Section& root, const std::string& task
   c.run_dir = root.get("run_dir", "runs/" + task);
   c.seed = root.get<uint64_t>("seed", c.seed);
   c.threads = root.get("threads", c.threads);
+  if (c.threads < 0) throw root.error("threads", "must be >= 0 (0: all cores)");
   c.collect = CollectConfig::read(root.sub("collect"));
   c.transition = TransitionPolicyConfig::read(root.sub("transition"), obs_dim);
   c.switching = SwitchConfig::read(root.sub("switch"), obs_dim);

@@ -18,12 +18,11 @@ bool run_subtask(Env& env, TransitionController& after, int to, float* obs, int 
   after.resume(env, to);
   int begun = 0;
   for (int step = 0; step < max_steps; ++step) {
-    int skill = after.skill();
     after.act(env, obs, act.data());
-    if (after.skill() != skill && ++begun == lookahead) return true;  // a transition began
+    if (after.entered() >= 0 && ++begun == lookahead) return true;  // a transition began
     StepResult sr = env.step(act.data(), obs);
     if (steps) ++*steps;
-    if (sr.terminated) return false;
+    if (sr.terminated) return sr.info.success;  // a fall, or the whole task done (the last pick)
     if (sr.truncated) return true;
   }
   return true;

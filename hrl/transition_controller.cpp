@@ -19,6 +19,13 @@ void TransitionController::resume(const Env& env, int skill) {
   obs_dim_ = env.spec().obs_dim;
   skill_ = skill;
   transition_ = -1;
+  entered_ = -1;
+  // Handed over inside an interval into `skill`: that interval counts as taken, or a skill
+  // that hands over to itself would enter it again at once.
+  taken_.assign(meta_.transitions().size(), 0);
+  env.features(features_.data());
+  for (size_t t = 0; t < taken_.size(); ++t)
+    taken_[t] = meta_.transitions()[t].to == skill && MetaController::holds(meta_.transitions()[t].when, features_.data());
 }
 
 bool TransitionController::hand_over(const float* obs) {
@@ -36,13 +43,18 @@ bool TransitionController::hand_over(const float* obs) {
 
 void TransitionController::act(const Env& env, const float* obs, float* action) {
   env.features(features_.data());
+  entered_ = -1;
+  for (size_t t = 0; t < taken_.size(); ++t)
+    if (taken_[t] && !MetaController::holds(meta_.transitions()[t].when, features_.data())) taken_[t] = 0;
   if (transition_ >= 0) {
     const Transition& tr = meta_.transitions()[transition_];
     if (!tr.running(features_.data(), steps_) || hand_over(obs)) transition_ = -1;
   }
   if (transition_ < 0) {
-    int t = meta_.active_transition(skill_, features_.data());
+    int t = meta_.active_transition(skill_, features_.data(), &taken_);
     if (t >= 0) {
+      entered_ = t;
+      taken_[t] = 1;
       skill_ = meta_.transitions()[t].to;  // pi_b is next, whoever drives the interval
       if (artefacts_[t].policy) {
         transition_ = t, steps_ = 0;

@@ -40,11 +40,15 @@ class TransitionController : public Controller {
                        std::vector<TransitionArtefacts> artefacts, SwitchRule rule);
   void reset(const Env& env, const float* obs) override;
   // Carries on an episode already under way with `skill` in control and no transition
-  // running (switch training hands the episode over here after pi_ab).
+  // running (switch training hands the episode over here after pi_ab). An interval into
+  // `skill` that holds now is the one just handed over in: it is not entered again.
   void resume(const Env& env, int skill);
   void act(const Env& env, const float* obs, float* action) override;
   int skill() const { return skill_; }
   int transition() const { return transition_; }  // the transition pi_ab is running, or -1
+  // The transition whose interval the last act() entered (control passed to pi_ab, or
+  // straight to pi_b), or -1.
+  int entered() const { return entered_; }
 
  private:
   bool hand_over(const float* obs);
@@ -56,6 +60,8 @@ class TransitionController : public Controller {
   std::vector<float> out_, q_in_;
   int obs_dim_ = 0;
   int skill_ = 0, transition_ = -1, steps_ = 0;  // steps_: pi_ab's in this interval
+  int entered_ = -1;
+  std::vector<char> taken_;  // per transition: entered, and its interval not left since
 };
 
 }  // namespace segue

@@ -244,14 +244,25 @@ TEST(MetaController, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
   skills[1].name = "crawl";
   const std::string head = "start: [{skill: walk}]\ntransitions:\n  - {from: walk, to: crawl, when: {ceiling_ahead: [2, 3]}, ";
   Recipe ok = Recipe::parse(head + "expert: {task: walker_crawl, steps: 150}}", "r.yaml");
-  MetaController meta(ok.root(), skills, {"ceiling_ahead"});
+  // The sub-task's own features, for an expert window written in them.
+  auto own = [](const std::string& task) {
+    if (task != "walker_crawl") throw Error("unknown task '" + task + "'");
+    return std::vector<std::string>{"steps", "ceiling_behind"};
+  };
+  MetaController meta(ok.root(), skills, {"ceiling_ahead"}, own);
   EXPECT_EQ(meta.transitions()[0].expert_task, "walker_crawl");
   EXPECT_EQ(meta.transitions()[0].expert_steps, 150);
-  EXPECT_EQ(meta.transitions()[0].expert_when.size(), 1u);  // unused with a task; the interval
+  EXPECT_TRUE(meta.transitions()[0].expert_when.empty());  // not the interval: that is this task's
+  Recipe windowed = Recipe::parse(head + "expert: {task: walker_crawl, when: {ceiling_behind: [1, 2]}}}", "r.yaml");
+  const Transition w = MetaController(windowed.root(), skills, {"ceiling_ahead"}, own).transitions()[0];
+  EXPECT_EQ(w.expert_steps, 0);
+  ASSERT_EQ(w.expert_when.size(), 1u);
+  EXPECT_EQ(w.expert_when[0].feature, 1);  // ceiling_behind among the sub-task's features
+  EXPECT_EQ(w.expert_when[0].lo, 1.0);
   auto refused = [&](const std::string& expert, const std::string& message) {
     Recipe r = Recipe::parse(head + "expert: " + expert + "}", "r.yaml");
     try {
-      MetaController(r.root(), skills, {"ceiling_ahead"});
+      MetaController(r.root(), skills, {"ceiling_ahead"}, own);
       ADD_FAILURE() << expert;
     } catch (const Error& e) {
       EXPECT_EQ(std::string(e.what()), message);
@@ -275,10 +286,44 @@ TEST(MetaController, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
   } catch (const Error& e) {
     EXPECT_EQ(std::string(e.what()), "r.yaml: key 'transitions.0.max_steps': must be positive");
   }
-  refused("{task: walker_crawl}", "r.yaml: missing required key 'transitions.0.expert.steps'");
+  refused("{task: walker_crawl}", "r.yaml: key 'transitions.0.expert.task': give pi_b's window on it: expert.steps "
+                                  "and/or expert.when (over its features)");
   refused("{task: walker_crawl, steps: 0}", "r.yaml: key 'transitions.0.expert.steps': must be positive");
   refused("{task: walker_crawl, steps: 9, when: {ceiling_ahead: [0, 1]}}",
-          "r.yaml: key 'transitions.0.expert.when': applies to this task's features; with expert.task give expert.steps");
+          "r.yaml: key 'transitions.0.expert.when.ceiling_ahead': the task has no feature 'ceiling_ahead' "
+          "(features: steps, ceiling_behind)");
+  refused("{task: walker_jog, steps: 9}", "r.yaml: key 'transitions.0.expert.task': unknown task 'walker_jog'");
+}
+
+TEST(MetaController, ATrainingWindowApartFromTheInterval) {
+  std::vector<Skill> skills(2);
+  skills[0].name = "walk";
+  skills[1].name = "jump";
+  const std::string head = "start: [{skill: walk}]\ntransitions:\n  - {from: walk, to: jump, when: {curb_ahead: [3, 4]}";
+  // By default pi_ab trains in the interval itself, with its cap.
+  Recipe plain = Recipe::parse(head + ", max_steps: 50}", "r.yaml");
+  const Transition p = MetaController(plain.root(), skills, {"curb_ahead"}).transitions()[0];
+  ASSERT_EQ(p.training_when.size(), 1u);
+  EXPECT_EQ(p.training_when[0].lo, 3.0);
+  EXPECT_EQ(p.training_max_steps, 50);
+  // The reference's Hurdle: evaluated 4 to 3 m before the curb, trained from 4 to 2 m.
+  Recipe wide = Recipe::parse(head + ", max_steps: 50, training: {when: {curb_ahead: [2, 4]}}}", "r.yaml");
+  const Transition t = MetaController(wide.root(), skills, {"curb_ahead"}).transitions()[0];
+  const Transition window = t.training_window();
+  const double at_2_5[1] = {2.5}, at_3_5[1] = {3.5};
+  EXPECT_FALSE(t.running(at_2_5, 0));
+  EXPECT_TRUE(window.running(at_2_5, 0));
+  EXPECT_TRUE(window.running(at_3_5, 0));
+  EXPECT_EQ(window.max_steps, 0);  // a training window without max_steps has no cap
+  EXPECT_TRUE(window.running(at_3_5, 1000));
+  EXPECT_FALSE(t.running(at_3_5, 50));
+  try {
+    Recipe empty = Recipe::parse(head + ", training: {}}", "r.yaml");
+    MetaController(empty.root(), skills, {"curb_ahead"});
+    ADD_FAILURE() << "an empty training window was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "r.yaml: key 'transitions.0.training': give its window: when and/or max_steps");
+  }
 }
 
 }  // namespace segue

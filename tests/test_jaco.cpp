@@ -9,51 +9,12 @@
 #include "core/vector_env.h"
 #include "environments/jaco_skills.h"
 #include "hrl/evaluation.h"
-#include "tests/task_fixture.h"
+#include "tests/jaco_fixture.h"
 
 namespace segue {
 namespace {
 
 constexpr double kG = 9.81;
-
-template <class T>
-std::unique_ptr<T> make_arm(const std::string& task, const std::string& env = "{}") {
-  std::unique_ptr<Env> e = make_task(task, env);
-  T* raw = dynamic_cast<T*>(e.get());
-  EXPECT_NE(raw, nullptr);
-  e.release();
-  return std::unique_ptr<T>(raw);
-}
-
-mjModel* writable(const MujocoEnv& env) { return const_cast<mjModel*>(env.model()); }
-
-// Turns off every contact of the arm's geoms, so the object flies as if the arm were absent.
-void arm_contacts_off(const MujocoEnv& env) {
-  mjModel* m = writable(env);
-  int object = mj_name2id(m, mjOBJ_BODY, "object");
-  for (int g = 0; g < m->ngeom; ++g)
-    if (m->geom_bodyid[g] != 0 && m->geom_bodyid[g] != object) m->geom_contype[g] = m->geom_conaffinity[g] = 0;
-}
-
-void object_contacts_off(const MujocoEnv& env) {
-  mjModel* m = writable(env);
-  int g = mj_name2id(m, mjOBJ_GEOM, "object");
-  m->geom_contype[g] = m->geom_conaffinity[g] = 0;
-}
-
-// Holds the arm still at `q` (arm joints only), as a scripted sequence needs.
-void hold_arm(JacoEnv& env, const std::vector<double>& q) {
-  mjData* d = env.mutable_data();
-  for (int i = 0; i < JacoEnv::kArmDof; ++i) {
-    d->qpos[i] = i < int(q.size()) ? q[i] : 0.0;
-    d->qvel[i] = 0.0;
-  }
-}
-
-void pin(JacoEnv& env, const Vec3& p, std::vector<float>& obs) {
-  env.pin_object(p);
-  env.forward(obs.data());
-}
 
 }  // namespace
 

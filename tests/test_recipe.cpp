@@ -7,6 +7,7 @@
 #include <fstream>
 #include <set>
 
+#include "core/mujoco_env.h"
 #include "core/recipe.h"
 #include "tests/cli_run.h"
 #include "tests/temp_dir.h"
@@ -151,6 +152,50 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run(patrol + "transition.discriminator.gradient_penalty=-1"),
                         "key 'transition.discriminator.gradient_penalty': must be >= 0");
   expect_one_line_error(run(patrol + "transitions.0.max_steps=0"), "key 'transitions.0.max_steps': must be positive");
+}
+
+TEST_F(CliErrors, NonsenseRefusedBeforeWork) {
+  // Checks that hold for every key of their kind, not case by case: numbers must be finite,
+  // a key must have a value, a key may be given once, layer widths are positive.
+  auto ok = write("ok.yaml", "task: walker_forward\n");
+  expect_one_line_error(run("train " + ok + " --set env.push_prob=.nan"), "key 'env.push_prob' must be a finite number, got .nan");
+  expect_one_line_error(run("train " + ok + " --set ppo.lr=.inf"), "key 'ppo.lr' must be a finite number, got .inf");
+  expect_one_line_error(run("train " + ok + " --set ppo.total_steps="), "key 'ppo.total_steps' has no value");
+  expect_one_line_error(run("train " + ok + " --set .ppo.total_steps=8192"), "'.ppo.total_steps' is not a key");
+  auto twice = write("dup.yaml", "task: walker_forward\nppo: {lr: 0.1}\nppo: {lr: 0.2}\n");
+  expect_one_line_error(run("train " + twice), "dup.yaml: key 'ppo' is given twice");
+  expect_one_line_error(run("train " + ok + " --set 'policy.pi_hidden=[32, 0]'"),
+                        "key 'policy.pi_hidden': layer widths must be positive, got 0");
+  expect_one_line_error(run("train " + ok + " --set ppo.total_steps=0"), "key 'ppo.total_steps': must be positive, got 0");
+  expect_one_line_error(run("train " + ok + " --set ppo.num_envs=100000000"), "key 'ppo.num_envs': must be in [1, 4096]");
+  expect_one_line_error(run("train " + ok + " --set ppo.clip=-0.2"), "key 'ppo.clip': must be > 0");
+  expect_one_line_error(run("train " + ok + " --set ppo.num_envs=2 --set ppo.steps_per_env=64"),
+                        "key 'ppo.minibatch_size': 2048 is larger than a rollout (num_envs x steps_per_env = 128)");
+  expect_one_line_error(run("train " + ok + " --set threads=-3"), "key 'threads': must be >= 0");
+  expect_one_line_error(run("train " + ok + " --set eval.episodes=0"), "key 'eval.episodes': must be positive");
+  const std::string serve = "eval --task serve --method tp --episodes 1 --recipe " + std::string(SEGUE_SOURCE_DIR) +
+                            "/experiments/serve.yaml --set ";
+  expect_one_line_error(run(serve + "'switch.hidden=[0]'"), "key 'switch.hidden': layer widths must be positive, got 0");
+  expect_one_line_error(run(serve + "'eval.seeds=[]'"), "key 'eval.seeds': lists no seed");
+  expect_one_line_error(run(serve + "'transitions=[]'"), "key 'transitions': lists no transition");
+  expect_one_line_error(run(serve + "'transitions.1={from: toss, to: hit}'"),
+                        "key 'transitions.1.to': a second transition toss -> hit");
+  expect_one_line_error(run(serve + "'transitions.0.when.since_release=[.nan, 4]'"),
+                        "key 'transitions.0.when.since_release' must hold finite numbers, got .nan");
+  expect_one_line_error(run(serve + "'transition.policy.pi_hidden=[32, 32]'"),
+                        "key 'transition.policy.pi_hidden': [32, 32], but pi_ab starts as skill 'hit' (init_from_next), "
+                        "whose hidden layers are [64, 64]");
+}
+
+TEST(MuJoCo, ItsErrorsBecomeSegueErrors) {
+  // MuJoCo's default handler would print "Press Enter to exit" and wait on stdin.
+  install_mujoco_handlers();
+  try {
+    mju_error("a test error");
+    ADD_FAILURE() << "mju_error returned";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "MuJoCo: a test error");
+  }
 }
 
 TEST_F(CliErrors, BadPoliciesAndFlags) {

@@ -283,14 +283,6 @@ class FfmpegPipe {
   FILE* pipe_ = nullptr;
 };
 
-// MuJoCo's default error handler prints and exits in its own style; a failure inside the
-// renderer (e.g. no usable OpenGL) should end like every other segue error. Exceptions
-// cannot be thrown through MuJoCo's C code, so exit here.
-void on_mujoco_error(const char* msg) {
-  std::fprintf(stderr, "error: segue render: MuJoCo: %s\n", msg);
-  std::exit(1);
-}
-
 }  // namespace
 
 int render_main(int argc, char** argv) {
@@ -343,7 +335,7 @@ int render_main(int argc, char** argv) {
   if (video && (width % 2 || height % 2)) throw Error("segue render: H.264 video needs an even --width and --height");
   if (!video) fs::create_directories(frames_dir);
 
-  mju_user_error = on_mujoco_error;
+  install_mujoco_handlers();  // a failing mjr_ call is an error line, not a prompt
   EglContext gl;  // must outlive the renderer, which frees GL resources
   // MujocoEnv hands out its model as const, but each env owns a private copy of it;
   // the renderer only raises that copy's offscreen buffer size (a visual setting).
