@@ -10,6 +10,7 @@
 #include "hrl/composite_recipe.h"
 #include "hrl/switch_training.h"
 #include "hrl/transition_controller.h"
+#include "core/rng.h"
 #include "tests/jaco_fixture.h"
 
 namespace segue {
@@ -251,6 +252,39 @@ TEST(RepetitivePicking, ThePickHandsOverToItselfOncePerSuccess) {
   ASSERT_EQ(features_of(*env)[3], 0);
   for (int t = 0; t < 10; ++t) env->step(kZero.data(), obs.data());  // pi_ab's steps, say
   EXPECT_FALSE(run_subtask(*env, without_tp, 0, obs.data(), /*lookahead=*/1, 3000));
+}
+
+TEST(JacoComposites, SnapshotsReplayExactlyWithTheirBookkeeping) {
+  // S_a states are such snapshots: restoring one reproduces the next steps exactly, the
+  // task's counters (picks, the pinned box, the toss's flags) included.
+  for (const std::string task : {"repetitive_picking", "repetitive_catching", "serve"}) {
+    auto env = make_task(task);
+    const int n = env->spec().obs_dim;
+    std::vector<float> obs(n), act(9);
+    Rng rng(3);
+    env->reset(11, obs.data());
+    for (int t = 0; t < 30; ++t) {
+      for (auto& a : act) a = float(rng.symmetric(1.0));
+      env->step(act.data(), obs.data());
+    }
+    std::vector<double> state;
+    env->save_state(state);
+    std::vector<std::vector<float>> first;
+    std::vector<float> actions;
+    for (int t = 0; t < 20; ++t) {
+      for (auto& a : act) a = float(rng.symmetric(1.0)), actions.push_back(a);
+      env->step(act.data(), obs.data());
+      first.push_back(obs);
+      first.back().push_back(float(features_of(*env).back()));
+    }
+    env->restore_state(state, obs.data());
+    for (int t = 0; t < 20; ++t) {
+      env->step(actions.data() + 9 * t, obs.data());
+      obs.push_back(float(features_of(*env).back()));
+      ASSERT_EQ(obs, first[t]) << task << " step " << t;
+      obs.resize(n);
+    }
+  }
 }
 
 }  // namespace segue

@@ -38,7 +38,7 @@ TEST(Shipped, EveryWalkerPolicyRunsOnItsTask) {
 }
 
 TEST(Shipped, CompositeRecipesLoadWithTheirSkills) {
-  for (const std::string task : {"hurdle", "obstacle_course", "patrol"}) {
+  for (const std::string task : {"hurdle", "obstacle_course", "patrol", "repetitive_picking", "repetitive_catching", "serve"}) {
     std::string file = CompositeRecipe::default_file(task);
     // A recipe whose skills are not all trained yet is reported, not failed.
     std::string missing;
@@ -58,24 +58,40 @@ TEST(Shipped, CompositeRecipesLoadWithTheirSkills) {
   }
 }
 
-// Patrol's shipped transition policies and Q-networks drive every transition method, and
-// With TP reproduces its row of experiments/results/patrol.json on evaluation seed 0.
-TEST(Shipped, PatrolTransitionMethodsReproduceTheirTable) {
-  CompositeRecipe r = CompositeRecipe::load(CompositeRecipe::default_file("patrol"));
-  for (const std::string method : {"tp", "lee", "tp+q"}) {
-    EvalResult e = evaluate(r.make_env, method_controllers(r, method), 2, 0, 2);
-    for (double ret : e.returns) EXPECT_TRUE(std::isfinite(ret)) << method;
-  }
-  std::ifstream json(std::string(SEGUE_SOURCE_DIR) + "/experiments/results/patrol.json");
+namespace {
+
+// The mean success count of `method` on evaluation seed 0 in experiments/results/TASK.json.
+double table_seed0(const std::string& task, const std::string& method) {
+  std::ifstream json(std::string(SEGUE_SOURCE_DIR) + "/experiments/results/" + task + ".json");
   std::string text((std::istreambuf_iterator<char>(json)), {});
-  size_t at = text.find("\"tp\": {");
-  ASSERT_NE(at, std::string::npos);
+  size_t at = text.find("\"" + method + "\": {");
+  EXPECT_NE(at, std::string::npos) << task << " " << method;
+  if (at == std::string::npos) return NAN;
   at = text.find("\"per_seed_means\": [", at);
-  double seed0 = std::stod(text.substr(at + std::string("\"per_seed_means\": [").size()));
-  EvalResult e = evaluate(r.make_env, method_controllers(r, "tp"), r.eval_episodes, 0, 2);
+  return std::stod(text.substr(at + std::string("\"per_seed_means\": [").size()));
+}
+
+// The shipped transition artefacts drive every transition method, and `method` reproduces
+// its row of experiments/results/TASK.json on evaluation seed 0.
+void reproduces_its_table(const std::string& task, const std::string& method) {
+  CompositeRecipe r = CompositeRecipe::load(CompositeRecipe::default_file(task));
+  for (const std::string m : {"tp", "lee", "tp+q"}) {
+    EvalResult e = evaluate(r.make_env, method_controllers(r, m), 2, 0, 2);
+    for (double ret : e.returns) EXPECT_TRUE(std::isfinite(ret)) << task << " " << m;
+  }
+  EvalResult e = evaluate(r.make_env, method_controllers(r, method), r.eval_episodes, 0, 2);
   double mean = 0;
   for (double c : e.success_counts) mean += c / e.success_counts.size();
-  EXPECT_NEAR(mean, seed0, 1e-9);
+  EXPECT_NEAR(mean, table_seed0(task, method), 1e-9) << task << " " << method;
+}
+
+}  // namespace
+
+TEST(Shipped, PatrolTransitionMethodsReproduceTheirTable) { reproduces_its_table("patrol", "tp"); }
+// The arm's: a composite of two skills (Serve) and a skill handing over to itself.
+TEST(Shipped, ServeTransitionMethodsReproduceTheirTable) { reproduces_its_table("serve", "tp+q"); }
+TEST(Shipped, RepetitiveCatchingTransitionMethodsReproduceTheirTable) {
+  reproduces_its_table("repetitive_catching", "tp+q");
 }
 
 TEST(Shipped, CompositeRecipeRefusesBadSkills) {
