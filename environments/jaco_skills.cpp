@@ -217,7 +217,7 @@ void HitRule::place(JacoEnv& env, Rng& rng) const {
   Vec3 p = cfg.start;
   for (auto& x : p) x += rng.symmetric(cfg.start_noise);
   env.place_object(p, 0.0, cfg.vel_noise);
-  env.move_geom("target", cfg.target);  // drawn where the rule measures it
+  place_target(env);
 }
 
 void HitRule::begin(const JacoEnv& env) {

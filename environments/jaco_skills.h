@@ -143,6 +143,8 @@ struct HitRule {
   State s;
 
   void place(JacoEnv& env, Rng& rng) const;
+  // Moves the target geom to where the rule measures it (Serve, which places its own ball).
+  void place_target(JacoEnv& env) const { env.move_geom("target", cfg.target); }
   void begin(const JacoEnv& env);
   // dt: the control step, for the ball's x velocity by finite differences.
   RuleStep step(const JacoEnv& env, double dt);

@@ -143,7 +143,7 @@ void JacoServe::features(double* out) const {
 
 void JacoServe::place_task_object() {
   toss_.place(*this, rng_);
-  move_geom("target", hit_.cfg.target);
+  hit_.place_target(*this);
 }
 
 void JacoServe::begin_task() {
