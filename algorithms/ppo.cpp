@@ -55,9 +55,18 @@ PpoConfig PpoConfig::read(const Section& s, PpoConfig c) {
   return c;
 }
 
-PPO::PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed)
-    : cfg_(config), envs_(envs), obs_rms_(net.obs_dim, config.obs_clip), return_rms_(1),
-      seed_(seed) {
+PPO::PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed,
+         const Distributed& group)
+    : cfg_(config), envs_(envs), obs_rms_(net.obs_dim, config.obs_clip), return_rms_(1), group_(group),
+      global_envs_(envs.size()), seed_(seed) {
+  if (!group_.single()) {
+    double n = envs.size();
+    group_.sum(&n, 1);
+    global_envs_ = int64_t(n);
+    if (global_envs_ != cfg_.num_envs)
+      throw Error("PPO: the ranks step " + std::to_string(global_envs_) + " environments in all, ppo.num_envs is " +
+                  std::to_string(cfg_.num_envs));
+  }
   torch::manual_seed(mix_seed(seed, 0x5e9e));
   net_ = ActorCritic(net);
   if (!net.ignore_obs.empty()) obs_rms_.ignore(net.ignore_obs.at(0), net.ignore_obs.at(1));
@@ -68,6 +77,8 @@ PPO::PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, u
   mean_.resize(size_t(envs.size()) * net.act_dim);
   noise_.resize(size_t(envs.size()) * net.act_dim);
   noise_age_.assign(envs.size(), 0);
+  env_rng_.resize(envs.size());
+  return_samples_.resize(size_t(cfg_.steps_per_env) * envs.size());
   envs_.reset(mix_seed(seed, 0));
   refresh_inference_copy();
 }
@@ -99,17 +110,20 @@ void PPO::refresh_inference_copy() {
 IterationStats PPO::iterate() {
   IterationStats stats;
   // Per-iteration seeds make a resumed run draw the same noise as an uninterrupted one.
-  rng_.seed(mix_seed(seed_, 2 * iteration_ + 1));
+  const uint64_t noise_seed = mix_seed(seed_, 2 * iteration_ + 1);
+  for (int i = 0; i < envs_.size(); ++i) env_rng_[i].seed(mix_seed(noise_seed, uint64_t(envs_.first_index() + i)));
   torch::manual_seed(mix_seed(seed_, 2 * iteration_ + 2));
   auto t0 = std::chrono::steady_clock::now();
+  const double comm0 = group_.comm_seconds();
   collect_rollout(stats);
   auto t1 = std::chrono::steady_clock::now();
   update(stats);
   auto t2 = std::chrono::steady_clock::now();
   stats.rollout_seconds = std::chrono::duration<double>(t1 - t0).count();
   stats.update_seconds = std::chrono::duration<double>(t2 - t1).count();
+  stats.comm_seconds = group_.comm_seconds() - comm0;
   ++iteration_;
-  global_step_ += cfg_.rollout_size();
+  global_step_ += int64_t(buf_.T) * global_envs_;
   wall_seconds_ += stats.rollout_seconds + stats.update_seconds;
   stats.iteration = iteration_;
   stats.global_step = global_step_;
@@ -126,7 +140,7 @@ void PPO::sample_actions(int t) {
     const float* mu = &mean_[size_t(i) * A];
     float* eps = &noise_[size_t(i) * A];
     if (noise_age_[i]++ % cfg_.noise_repeat == 0)
-      for (int j = 0; j < A; ++j) eps[j] = static_cast<float>(rng_.normal());
+      for (int j = 0; j < A; ++j) eps[j] = static_cast<float>(env_rng_[i].normal());
     for (int j = 0; j < A; ++j) a[j] = mu[j] + std::exp(log_std_[j]) * eps[j];
     buf_.log_probs[size_t(t) * N + i] = static_cast<float>(gaussian_log_prob(a, mu, log_std_.data(), A));
   }
@@ -137,7 +151,6 @@ void PPO::collect_rollout(IterationStats& stats) {
   buf_.truncated_index.clear();
   buf_.truncated_obs.clear();
   envs_.finished().clear();
-  float ret_sample[1];
   for (int t = 0; t < T; ++t) {
     std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf_.raw_obs_at(t));
     for (int i = 0; i < N; ++i)
@@ -160,36 +173,39 @@ void PPO::collect_rollout(IterationStats& stats) {
       }
     }
   }
-  // Episode statistics, in the task's own reward units.
-  auto& done = envs_.finished();
-  stats.episodes = static_cast<int>(done.size());
-  if (!done.empty()) {
-    double ret = 0, len = 0, succ = 0, count = 0;
-    for (const auto& e : done) ret += e.ret, len += e.length, succ += e.success, count += e.success_count;
-    stats.episode_return = ret / done.size();
-    stats.episode_length = len / done.size();
-    stats.success_rate = succ / done.size();
-    stats.success_count = count / done.size();
+  // Episode statistics over every rank, in the task's own reward units.
+  double totals[5] = {double(envs_.finished().size()), 0, 0, 0, 0};
+  for (const auto& e : envs_.finished())
+    totals[1] += e.ret, totals[2] += e.length, totals[3] += e.success, totals[4] += e.success_count;
+  group_.sum(totals, 5);
+  stats.episodes = static_cast<int>(totals[0]);
+  if (stats.episodes > 0) {
+    stats.episode_return = totals[1] / totals[0];
+    stats.episode_length = totals[2] / totals[0];
+    stats.success_rate = totals[3] / totals[0];
+    stats.success_count = totals[4] / totals[0];
   }
 
   if (reward_hook_) reward_hook_(buf_);
-  // The scale of rewards: the std of the discounted return, tracked per environment.
+  // The scale of rewards: the std of the discounted return, tracked per environment and
+  // pooled over the rollout (and the ranks).
   for (int t = 0; t < T; ++t)
     for (int i = 0; i < N; ++i) {
       size_t k = size_t(t) * N + i;
       double r = buf_.raw_rewards[k];
       buf_.rewards[k] = static_cast<float>(r);
       running_return_[i] = running_return_[i] * cfg_.gamma + r;
-      ret_sample[0] = static_cast<float>(running_return_[i]);
-      return_rms_.update(ret_sample, 1);
+      return_samples_[k] = static_cast<float>(running_return_[i]);
       if (buf_.dones[k]) running_return_[i] = 0.0;
     }
+  return_rms_.update(return_samples_.data(), int64_t(T) * N, &group_);
   if (cfg_.normalize_reward) {
     float scale = static_cast<float>(1.0 / std::sqrt(return_rms_.var()[0] + 1e-8));
     for (auto& r : buf_.rewards) r = std::clamp(r * scale, -10.0f, 10.0f);
   }
-  for (float r : buf_.rewards)
-    if (!std::isfinite(r)) throw Error("task '" + envs_.spec().name + "' produced a non-finite reward");
+  bool finite = true;
+  for (float r : buf_.rewards) finite = finite && std::isfinite(r);
+  if (group_.any(!finite)) throw Error("task '" + envs_.spec().name + "' produced a non-finite reward");
 
   torch::NoGradGuard no_grad;
   auto values = net_->value(torch::from_blob(buf_.obs.data(), {int64_t(T) * N, I}));
@@ -208,11 +224,12 @@ void PPO::collect_rollout(IterationStats& stats) {
   compute_gae(buf_.rewards, buf_.values, buf_.dones, last_values, T, N, cfg_.gamma, cfg_.lambda,
               buf_.advantages, buf_.returns);
   // The normaliser learns from this rollout only after the policy has used it.
-  obs_rms_.update(buf_.raw_obs.data(), int64_t(T) * N);
+  obs_rms_.update(buf_.raw_obs.data(), int64_t(T) * N, &group_);
 }
 
 void PPO::update(IterationStats& stats) {
-  const int64_t M = int64_t(buf_.T) * buf_.N;
+  const int64_t T = buf_.T, N = buf_.N, first = envs_.first_index();
+  const int64_t M = T * global_envs_;  // rows of the whole rollout, every rank's
   const int64_t mb = std::min<int64_t>(cfg_.minibatch_size, M);
   if (cfg_.anneal_lr) {
     const double span = double(total_iterations() - schedule_start_);
@@ -220,53 +237,90 @@ void PPO::update(IterationStats& stats) {
     for (auto& group : optimizer_->param_groups())
       static_cast<torch::optim::AdamOptions&>(group.options()).lr(cfg_.lr * std::max(frac, 0.0));
   }
-  auto obs = torch::from_blob(buf_.obs.data(), {M, buf_.in_dim});
-  auto act = torch::from_blob(buf_.actions.data(), {M, buf_.act_dim});
-  auto old_logp = torch::from_blob(buf_.log_probs.data(), {M});
-  auto adv = torch::from_blob(buf_.advantages.data(), {M});
-  auto ret = torch::from_blob(buf_.returns.data(), {M});
+  auto obs = torch::from_blob(buf_.obs.data(), {T * N, buf_.in_dim});
+  auto act = torch::from_blob(buf_.actions.data(), {T * N, buf_.act_dim});
+  auto old_logp = torch::from_blob(buf_.log_probs.data(), {T * N});
+  auto adv = torch::from_blob(buf_.advantages.data(), {T * N});
+  auto ret = torch::from_blob(buf_.returns.data(), {T * N});
   const auto& spec = envs_.spec();
   auto low = torch::tensor(spec.act_low), high = torch::tensor(spec.act_high);
   int batches = 0;
+  double sums[4] = {0, 0, 0, 0};  // policy, value, approx_kl, clip_fraction, weighted by rows
   for (int epoch = 0; epoch < cfg_.epochs; ++epoch) {
     auto perm = torch::randperm(M, torch::kLong);
     for (int64_t start = 0; start < M; start += mb) {
       auto idx = perm.slice(0, start, std::min(start + mb, M));
-      auto o = obs.index_select(0, idx);
-      auto a = adv.index_select(0, idx);
-      a = (a - a.mean()) / (a.std() + 1e-8);
-      auto mean = net_->mean(o);
-      auto logp = net_->log_prob(mean, act.index_select(0, idx));
-      auto value = net_->value(o);
-      PpoLoss loss = ppo_loss(logp, old_logp.index_select(0, idx), a, value, ret.index_select(0, idx),
-                              net_->entropy(), cfg_.clip, cfg_.vf_coef, cfg_.ent_coef);
-      if (cfg_.bound_coef > 0) loss.total = loss.total + cfg_.bound_coef * action_bound_loss(mean, low, high);
+      const double rows = double(idx.numel());
+      if (!group_.single()) {
+        // Row t * global_envs + e of the whole rollout is row t * N + (e - first) here.
+        auto t = idx.div(global_envs_, "floor"), e = idx.remainder(global_envs_) - first;
+        idx = (t * N + e).masked_select((e >= 0) & (e < N));
+      }
+      const double share = double(idx.numel()) / rows;  // this rank's part of the minibatch
+      auto a = adv.index_select(0, idx).to(torch::kFloat64);
+      // Advantages normalised over the whole minibatch (every rank's rows).
+      double moments[2] = {a.sum().item<double>(), a.pow(2).sum().item<double>()};
+      group_.sum(moments, 2);
+      const double mean = moments[0] / rows;
+      const double std = std::sqrt(std::max(moments[1] - rows * mean * mean, 0.0) / std::max(rows - 1.0, 1.0));
       optimizer_->zero_grad();
-      loss.total.backward();
+      double local = 0.0;
+      if (idx.numel() > 0) {
+        auto o = obs.index_select(0, idx);
+        auto an = ((a - mean) / (std + 1e-8)).to(torch::kFloat32);
+        auto mean_action = net_->mean(o);
+        auto logp = net_->log_prob(mean_action, act.index_select(0, idx));
+        auto value = net_->value(o);
+        PpoLoss loss = ppo_loss(logp, old_logp.index_select(0, idx), an, value, ret.index_select(0, idx),
+                                net_->entropy(), cfg_.clip, cfg_.vf_coef, cfg_.ent_coef);
+        if (cfg_.bound_coef > 0)
+          loss.total = loss.total + cfg_.bound_coef * action_bound_loss(mean_action, low, high);
+        (loss.total * share).backward();
+        local = loss.total.item<double>() * share;
+        sums[0] += loss.policy.item<double>() * share;
+        sums[1] += loss.value.item<double>() * share;
+        sums[2] += loss.approx_kl.item<double>() * share;
+        sums[3] += loss.clip_fraction.item<double>() * share;
+      }
+      const double total = sum_gradients(local);
+      if (!std::isfinite(total))
+        throw Error("PPO loss became " + std::to_string(total) + " at iteration " +
+                    std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
+                    "'); the last checkpoint is kept: lower ppo.lr or check the task's rewards");
       torch::nn::utils::clip_grad_norm_(net_->parameters(), cfg_.max_grad_norm);
       optimizer_->step();
       if (cfg_.min_log_std > -20.0) {
         torch::NoGradGuard no_grad;
         net_->log_std.clamp_min_(cfg_.min_log_std);
       }
-      double total = loss.total.item<double>();
-      if (!std::isfinite(total))
-        throw Error("PPO loss became " + std::to_string(total) + " at iteration " +
-                    std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
-                    "'); the last checkpoint is kept: lower ppo.lr or check the task's rewards");
-      stats.policy_loss += loss.policy.item<double>();
-      stats.value_loss += loss.value.item<double>();
-      stats.approx_kl += loss.approx_kl.item<double>();
-      stats.clip_fraction += loss.clip_fraction.item<double>();
       ++batches;
     }
   }
-  stats.policy_loss /= batches;
-  stats.value_loss /= batches;
-  stats.approx_kl /= batches;
-  stats.clip_fraction /= batches;
+  group_.sum(sums, 4);
+  stats.policy_loss = sums[0] / batches;
+  stats.value_loss = sums[1] / batches;
+  stats.approx_kl = sums[2] / batches;
+  stats.clip_fraction = sums[3] / batches;
   stats.entropy = net_->entropy().item<double>();
   refresh_inference_copy();
+}
+
+double PPO::sum_gradients(double loss) {
+  if (group_.single()) return loss;
+  std::vector<torch::Tensor> parts;
+  auto params = net_->parameters();
+  for (auto& p : params) parts.push_back(p.grad().defined() ? p.grad().reshape(-1) : torch::zeros({p.numel()}));
+  parts.push_back(torch::tensor({float(loss)}));
+  auto flat = torch::cat(parts);
+  group_.sum(flat);
+  int64_t k = 0;
+  for (auto& p : params) {
+    auto g = flat.slice(0, k, k + p.numel()).view(p.sizes());
+    if (p.grad().defined()) p.mutable_grad().copy_(g);
+    else p.mutable_grad() = g.clone();
+    k += p.numel();
+  }
+  return flat[k].item<double>();
 }
 
 torch::Tensor PPO::log_prob(const float* raw_obs, const float* actions, int64_t n) {
@@ -357,6 +411,54 @@ ObsFeatures read_features(torch::serialize::InputArchive& ar) {
 
 }  // namespace
 
+// The environments' episodes in flight with the trainer's per-environment state (action
+// noise, its age, the discounted return), as one rank holds them or as a checkpoint does.
+struct PPO::InFlight {
+  std::vector<double> state, running_return;
+  std::string rngs;
+  std::vector<float> noise;
+  std::vector<int64_t> noise_age;
+
+  void append(const InFlight& o) {
+    state.insert(state.end(), o.state.begin(), o.state.end());
+    rngs += o.rngs;
+    noise.insert(noise.end(), o.noise.begin(), o.noise.end());
+    noise_age.insert(noise_age.end(), o.noise_age.begin(), o.noise_age.end());
+    running_return.insert(running_return.end(), o.running_return.begin(), o.running_return.end());
+  }
+  void write(torch::serialize::OutputArchive& ar) const {
+    ar.write("episodes_state", torch::tensor(state, torch::kFloat64));
+    ar.write("episodes_rng", text_tensor(rngs));
+    ar.write("episodes_noise", torch::tensor(noise));
+    ar.write("episodes_noise_age", torch::tensor(noise_age));
+    ar.write("episodes_running_return", torch::tensor(running_return, torch::kFloat64));
+  }
+  bool read(torch::serialize::InputArchive& ar) {
+    torch::Tensor s, r, n, a, ret;
+    if (!(ar.try_read("episodes_state", s) && ar.try_read("episodes_rng", r) && ar.try_read("episodes_noise", n) &&
+          ar.try_read("episodes_noise_age", a) && ar.try_read("episodes_running_return", ret)))
+      return false;
+    state = to_doubles(s), rngs = to_text(r), noise = to_floats(n), noise_age = to_int64s(a);
+    running_return = to_doubles(ret);
+    return true;
+  }
+  std::string bytes() const {
+    torch::serialize::OutputArchive ar;
+    write(ar);
+    std::ostringstream out;
+    ar.save_to(out);
+    return out.str();
+  }
+  static InFlight from_bytes(const std::string& b) {
+    torch::serialize::InputArchive ar;
+    std::istringstream in(b);
+    ar.load_from(in);
+    InFlight f;
+    f.read(ar);
+    return f;
+  }
+};
+
 void PPO::save(const std::string& path, const std::string& note, const ArchiveWriter& extra) const {
   torch::serialize::OutputArchive ar;
   if (extra) extra(ar);
@@ -375,43 +477,61 @@ void PPO::save(const std::string& path, const std::string& note, const ArchiveWr
   ar.write("meta_act_low", torch::tensor(envs_.spec().act_low));
   ar.write("meta_act_high", torch::tensor(envs_.spec().act_high));
   ar.write("meta_note", text_tensor(note));
-  std::vector<double> episodes;
-  std::string rngs;
-  if (envs_.save_episodes(episodes, rngs)) {
-    ar.write("episodes_state", torch::tensor(episodes, torch::kFloat64));
-    ar.write("episodes_rng", text_tensor(rngs));
-    ar.write("episodes_noise", torch::tensor(noise_));
-    ar.write("episodes_noise_age", torch::tensor(std::vector<int64_t>(noise_age_.begin(), noise_age_.end())));
-    ar.write("episodes_running_return", torch::tensor(running_return_, torch::kFloat64));
+  // The episodes in flight, every rank's, in environment order.
+  InFlight mine;
+  const bool saved = envs_.save_episodes(mine.state, mine.rngs);
+  if (!group_.any(!saved)) {
+    mine.noise = noise_;
+    mine.noise_age.assign(noise_age_.begin(), noise_age_.end());
+    mine.running_return = running_return_;
+    InFlight all;
+    for (const std::string& part : group_.gather(group_.single() ? std::string() : mine.bytes()))
+      all.append(group_.single() ? mine : InFlight::from_bytes(part));
+    all.write(ar);
   }
+  if (!group_.leader()) return;
   std::ostringstream bytes;
   ar.save_to(bytes);
   write_file_atomic(path, bytes.str());
 }
 
 void PPO::load(const std::string& path, const ArchiveReader& extra, bool resume_episodes) {
+  // Rank 0 reads the file and every rank loads its bytes (other hosts need not see it).
+  const std::string kFailed = "\x01segue: unreadable\n";
+  std::string bytes;
+  if (group_.leader()) {
+    try {
+      bytes = read_file(path);
+    } catch (const Error& e) {
+      bytes = kFailed + e.what();
+    }
+  }
+  bytes = group_.broadcast(bytes);
+  if (bytes.rfind(kFailed, 0) == 0) throw Error(bytes.substr(kFailed.size()));
   torch::serialize::InputArchive ar;
-  torch::Tensor episodes, rngs, noise, noise_age, running_return;
+  InFlight saved;
   bool in_flight = false;
   try {
-    ar.load_from(path);
+    std::istringstream in(bytes);
+    ar.load_from(in);
     if (extra) extra(ar);
     read_state(ar, path);
-    in_flight = resume_episodes && ar.try_read("episodes_state", episodes) && ar.try_read("episodes_rng", rngs) &&
-                ar.try_read("episodes_noise", noise) && ar.try_read("episodes_noise_age", noise_age) &&
-                ar.try_read("episodes_running_return", running_return);
+    in_flight = resume_episodes && saved.read(ar);
   } catch (const c10::Error& e) {
     std::string what = e.what_without_backtrace();
     throw Error(path + ": unreadable checkpoint: " + what.substr(0, what.find('\n')));
   }
   refresh_inference_copy();
-  if (in_flight && size_t(noise.numel()) == noise_.size()) {
+  const int A = buf_.act_dim, first = envs_.first_index(), N = envs_.size();
+  if (in_flight && int64_t(saved.noise.size()) == global_envs_ * A) {
     try {
-      envs_.restore_episodes(to_doubles(episodes), to_text(rngs));
-      noise_ = to_floats(noise);
-      const std::vector<int64_t> ages = to_int64s(noise_age);
-      noise_age_.assign(ages.begin(), ages.end());
-      running_return_ = to_doubles(running_return);
+      std::vector<double> state;
+      std::string rngs;
+      VectorEnv::slice_episodes(saved.state, saved.rngs, first, N, state, rngs);
+      envs_.restore_episodes(state, rngs);
+      noise_.assign(saved.noise.begin() + size_t(first) * A, saved.noise.begin() + size_t(first + N) * A);
+      noise_age_.assign(saved.noise_age.begin() + first, saved.noise_age.begin() + first + N);
+      running_return_.assign(saved.running_return.begin() + first, saved.running_return.begin() + first + N);
       return;
     } catch (const Error& e) {
       throw Error(path + ": " + e.what());

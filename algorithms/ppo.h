@@ -13,6 +13,7 @@
 #include "core/recipe.h"
 #include "core/rng.h"
 #include "core/rollout_buffer.h"
+#include "core/distributed.h"
 #include "core/running_mean_std.h"
 #include "core/vector_env.h"
 
@@ -60,11 +61,18 @@ struct IterationStats {
   double episode_return = NAN, episode_length = NAN, success_rate = NAN, success_count = NAN;
   double policy_loss = 0, value_loss = 0, entropy = 0, approx_kl = 0, clip_fraction = 0;
   double rollout_seconds = 0, update_seconds = 0;
+  double comm_seconds = 0;          // of those, inside collectives with the other ranks
 };
 
 class PPO {
  public:
-  PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed);
+  // With `group` of several ranks, PPO is data-parallel: each rank steps its share of the
+  // environments (envs.first_index() says which), and every update is the one a single
+  // process with all of them makes, to float tolerance: the same minibatch rows (one
+  // permutation of the whole rollout), advantages normalised over the whole minibatch,
+  // gradients summed over ranks before the optimiser step, normalisers merged exactly.
+  PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed,
+      const Distributed& group = Distributed::alone());
 
   // One rollout of rollout_size() steps, then epochs of minibatch updates.
   // Throws segue::Error if the loss or the rewards stop being finite.
@@ -108,7 +116,9 @@ class PPO {
   double learning_rate() const;  // the rate the last update used
 
   // Checkpoint: network, optimiser, normalisers, counters and `note` (the resolved
-  // recipe), written atomically. `extra` adds an owner's state (a discriminator) to the
+  // recipe), written atomically; with several ranks, save() and load() are collectives:
+  // rank 0 writes (every rank's episodes in flight gathered in environment order, so the
+  // file is the one a single process writes) and reads (the bytes sent to every rank). `extra` adds an owner's state (a discriminator) to the
   // same file, so the two can never be saved at different iterations.
   using ArchiveWriter = std::function<void(torch::serialize::OutputArchive&)>;
   using ArchiveReader = std::function<void(torch::serialize::InputArchive&)>;
@@ -122,8 +132,12 @@ class PPO {
 
  private:
   void read_state(torch::serialize::InputArchive& ar, const std::string& path);  // load()'s body
+  struct InFlight;
   void sample_actions(int t);
   void refresh_inference_copy();
+  // Sums every parameter's gradient over the ranks, with `loss` (this rank's share of
+  // the minibatch loss) riding along; returns the whole minibatch's loss.
+  double sum_gradients(double loss);
   // The networks' input for one raw observation: normalised, then the periodic features.
   void net_input(const float* raw, float* out) const;
 
@@ -134,7 +148,10 @@ class PPO {
   EigenMlp actor_copy_;  // Eigen mirror of net_->actor for the rollout
   RunningMeanStd obs_rms_, return_rms_;
   RolloutBuffer buf_;
-  Rng rng_;
+  const Distributed& group_;
+  int64_t global_envs_;          // environments over every rank
+  std::vector<Rng> env_rng_;     // action noise, one stream per environment (any rank layout draws alike)
+  std::vector<float> return_samples_;  // the discounted returns of a rollout, for return_rms_
   uint64_t seed_;
   std::vector<double> running_return_;  // discounted return per env, for reward scaling
   std::vector<float> mean_, log_std_;

@@ -90,6 +90,18 @@ std::map<std::string, std::string> leaves(const std::string& yaml, const std::st
 }
 }  // namespace
 
+std::string recipe_difference(const std::string& a, const std::string& b, const std::string& file) {
+  auto la = leaves(a, file), lb = leaves(b, file);
+  for (const auto& [key, value] : la) {
+    auto it = lb.find(key);
+    if (it == lb.end() || it->second != value)
+      return "key '" + key + "': " + value + " against " + (it == lb.end() ? "absent" : it->second);
+  }
+  for (const auto& [key, value] : lb)
+    if (!la.count(key)) return "key '" + key + "': absent against " + value;
+  return "";
+}
+
 RunDir::RunDir(const std::string& dir, const std::string& resolved,
                const std::set<std::string>& defaulted)
     : dir_(dir) {

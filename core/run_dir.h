@@ -25,6 +25,10 @@ class MetricsCsv {
   std::ofstream out_;
 };
 
+// The first key (in dotted form, `threads` aside) whose value differs between two resolved
+// recipes, as "key 'ppo.lr': A against B"; empty if they agree.
+std::string recipe_difference(const std::string& a, const std::string& b, const std::string& file);
+
 class RunDir {
  public:
   // Opens or creates DIR. A DIR holding a different resolved recipe is refused, naming

@@ -12,22 +12,31 @@ RunningMeanStd::RunningMeanStd(int dim, double clip, double eps)
   refresh();
 }
 
-void RunningMeanStd::update(const float* rows, int64_t n) {
-  if (n <= 0) return;
+void RunningMeanStd::update(const float* rows, int64_t n, const Distributed* across) {
+  if (n <= 0 && !across) return;
   const int d = dim();
   std::vector<double>& bmean = batch_mean_;
   std::vector<double>& bvar = batch_var_;
-  bmean.assign(d, 0.0);
+  // The batch's moments over every rank's rows: sums first, then squared deviations from
+  // the common mean (two passes, as for one process).
+  bmean.assign(d + 1, 0.0);
   bvar.assign(d, 0.0);
   for (int64_t r = 0; r < n; ++r)
     for (int j = 0; j < d; ++j) bmean[j] += rows[r * d + j];
-  for (int j = 0; j < d; ++j) bmean[j] /= n;
+  bmean[d] = double(n);
+  if (across) across->sum(bmean.data(), bmean.size());
+  const double count = bmean[d];
+  bmean.pop_back();
+  if (count <= 0) return;
+  for (int j = 0; j < d; ++j) bmean[j] /= count;
   for (int64_t r = 0; r < n; ++r)
     for (int j = 0; j < d; ++j) {
       double c = rows[r * d + j] - bmean[j];
       bvar[j] += c * c;
     }
-  for (int j = 0; j < d; ++j) bvar[j] /= n;
+  if (across) across->sum(bvar.data(), bvar.size());
+  for (int j = 0; j < d; ++j) bvar[j] /= count;
+  n = int64_t(count);
   // Merge (count_, mean_, var_) with (n, bmean, bvar).
   double total = count_ + n;
   for (int j = 0; j < d; ++j) {

@@ -6,13 +6,16 @@
 
 #include <vector>
 
+#include "core/distributed.h"
+
 namespace segue {
 
 class RunningMeanStd {
  public:
   explicit RunningMeanStd(int dim = 0, double clip = 10.0, double eps = 1e-8);
-  // Adds a batch of `n` rows of length dim().
-  void update(const float* rows, int64_t n);
+  // Adds a batch of `n` rows of length dim(); with `across`, the batch is the union of
+  // every rank's rows (a collective: every rank calls it), merged exactly.
+  void update(const float* rows, int64_t n, const Distributed* across = nullptr);
   void normalize(const float* in, float* out) const;
   // Replaces the statistics, as if `count` rows with this mean and variance had been seen.
   void set(const std::vector<double>& mean, const std::vector<double>& var, double count);

@@ -1,12 +1,17 @@
 #include "core/thread_pool.h"
 
+#include <cstdlib>
+
 #include <algorithm>
 
 namespace segue {
 
 int resolve_threads(int requested) {
   if (requested > 0) return requested;
-  return std::max(1u, std::thread::hardware_concurrency());
+  // Ranks sharing a host (LOCAL_WORLD_SIZE, set by --nproc as torchrun does) share its cores.
+  const char* local = std::getenv("LOCAL_WORLD_SIZE");
+  const int ranks = local ? std::max(1, std::atoi(local)) : 1;
+  return std::max(1, int(std::thread::hardware_concurrency()) / ranks);
 }
 
 ThreadPool::ThreadPool(int threads) {

@@ -9,7 +9,8 @@
 
 namespace segue {
 
-VectorEnv::VectorEnv(const Factory& make, int num_envs, int threads) : pool_(threads) {
+VectorEnv::VectorEnv(const Factory& make, int num_envs, int threads, int first_index)
+    : pool_(threads), first_index_(first_index) {
   for (int i = 0; i < num_envs; ++i) envs_.push_back(make());
   obs_dim_ = spec().obs_dim;
   act_dim_ = spec().act_dim;
@@ -84,9 +85,29 @@ void VectorEnv::restore_episodes(const std::vector<double>& numbers, const std::
   if (k != numbers.size()) throw Error("saved episodes are for more environments than " + std::to_string(size()));
 }
 
+void VectorEnv::slice_episodes(const std::vector<double>& numbers, const std::string& rngs, int first, int count,
+                               std::vector<double>& out_numbers, std::string& out_rngs) {
+  out_numbers.clear();
+  out_rngs.clear();
+  std::istringstream lines(rngs);
+  size_t k = 0;
+  for (int i = 0; i < first + count; ++i) {
+    std::string rng;
+    if (k >= numbers.size() || !std::getline(lines, rng))
+      throw Error("saved episodes are for fewer environments than " + std::to_string(first + count));
+    const size_t record = 1 + size_t(numbers[k]) + 4 + kMaxMetrics;
+    if (k + record > numbers.size()) throw Error("saved episodes are truncated");
+    if (i >= first) {
+      out_numbers.insert(out_numbers.end(), numbers.begin() + k, numbers.begin() + k + record);
+      out_rngs += rng + "\n";
+    }
+    k += record;
+  }
+}
+
 void VectorEnv::reset(uint64_t seed) {
   for (int i = 0; i < size(); ++i) {
-    envs_[i]->reset(mix_seed(seed, i), &obs_[size_t(i) * obs_dim_]);
+    envs_[i]->reset(mix_seed(seed, uint64_t(first_index_ + i)), &obs_[size_t(i) * obs_dim_]);
     running_[i] = EpisodeStats{};
   }
   finished_.clear();

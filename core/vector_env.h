@@ -24,12 +24,15 @@ struct EpisodeStats {
 class VectorEnv {
  public:
   using Factory = std::function<std::unique_ptr<Env>()>;
-  VectorEnv(const Factory& make, int num_envs, int threads);
+  // `first_index`: where these environments sit among every rank's (data parallelism):
+  // environment i is seeded as environment first_index + i of one big vector would be.
+  VectorEnv(const Factory& make, int num_envs, int threads, int first_index = 0);
 
   int size() const { return static_cast<int>(envs_.size()); }
+  int first_index() const { return first_index_; }
   const EnvSpec& spec() const { return envs_[0]->spec(); }
   Env& env(int i) { return *envs_[i]; }
-  // Seeds environment i from mix_seed(seed, i) and resets all of them.
+  // Seeds environment i from mix_seed(seed, first_index + i) and resets all of them.
   void reset(uint64_t seed);
   // Applies actions [N, act_dim]; afterwards obs(), reward(), terminated(), truncated()
   // describe the step and finished episodes are appended to finished().
@@ -47,12 +50,16 @@ class VectorEnv {
   bool save_episodes(std::vector<double>& numbers, std::string& rngs) const;
   // Puts them back (same number of environments); throws segue::Error on a mismatch.
   void restore_episodes(const std::vector<double>& numbers, const std::string& rngs);
+  // Environments [first, first + count) of what save_episodes wrote for a larger vector
+  // (one rank's share of a checkpoint written for all of them).
+  static void slice_episodes(const std::vector<double>& numbers, const std::string& rngs, int first, int count,
+                             std::vector<double>& out_numbers, std::string& out_rngs);
   ThreadPool& pool() { return pool_; }
 
  private:
   std::vector<std::unique_ptr<Env>> envs_;
   ThreadPool pool_;
-  int obs_dim_, act_dim_;
+  int obs_dim_, act_dim_, first_index_;
   std::vector<float> obs_, final_obs_;
   std::vector<double> reward_;
   std::vector<uint8_t> terminated_, truncated_;

@@ -41,7 +41,8 @@ void expect_same_rows(const std::vector<std::vector<std::string>>& a, const std:
     ASSERT_EQ(a[r].size(), b[r].size()) << "row " << r;
     for (size_t c = 0; c < a[r].size(); ++c) {
       const std::string& name = a[0][c];
-      if (name == "rollout_seconds" || name == "update_seconds" || name == "wall_seconds") continue;
+      if (name == "rollout_seconds" || name == "update_seconds" || name == "wall_seconds" || name == "comm_seconds")
+        continue;
       EXPECT_EQ(a[r][c], b[r][c]) << "row " << r << " column " << name;
     }
   }

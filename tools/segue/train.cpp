@@ -5,7 +5,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <csignal>
 #include <map>
+#include <optional>
 #include <regex>
 #include <set>
 #include <sstream>
@@ -16,6 +18,7 @@
 #include "hrl/lead_in.h"
 #include "algorithms/skill_recipe.h"
 #include "core/assets.h"
+#include "core/distributed.h"
 #include "core/progress.h"
 #include "core/run_dir.h"
 #include "tools/segue/cli.h"
@@ -34,6 +37,7 @@ const Command kTrain{
     {"RECIPE"},
     {{"set", "key=value", "override a recipe key (repeatable), e.g. --set ppo.lr=1e-4", true},
      {"threads", "N", "threads for environments and LibTorch (overrides the recipe; 0 = all)"},
+     {"nproc", "N", "data-parallel PPO on N local ranks (c10d Gloo; see docs/distributed.md)"},
      {"check", "", "read and check the recipe (every stage), then stop"}}};
 
 // The end of every run: export the policy, evaluate it on the recipe's eval task, write
@@ -150,6 +154,21 @@ SkillRecipe read_skill(const Recipe& recipe, const std::string& default_run_dir)
 
 int train_skill(const Recipe& recipe, const SkillRecipe& s);
 int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool check_only);
+
+// Every rank must train the same recipe as rank 0: a difference is refused on every rank,
+// naming the first key that differs (`threads` may differ).
+void require_same_recipe(const Recipe& recipe) {
+  const Distributed& group = Distributed::world();
+  if (group.single()) return;
+  const std::string mine = recipe.resolved_yaml(), leaders = group.broadcast(mine);
+  const std::string diff = recipe_difference(leaders, mine, recipe.file());
+  std::string report;
+  const std::vector<std::string> all = group.gather(diff);
+  for (size_t r = 0; r < all.size() && report.empty(); ++r)
+    if (!all[r].empty())
+      report = recipe.file() + ": rank " + std::to_string(r) + " was started with another recipe than rank 0 (" + all[r] + ")";
+  if (!report.empty()) throw Error(report);
+}
 
 }  // namespace
 
@@ -275,10 +294,12 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
   // Every stage is read and checked before the first step of the first.
   for (size_t i = 0; i < stages.size(); ++i) read_skill(stage_recipe(i, "(the stage before)", 0), top);
   if (check_only) return std::printf("%s: ok (%zu stages)\n", recipe.file().c_str(), stages.size()) < 0;
-  std::filesystem::create_directories(top);
+  // With several ranks, rank 0's files decide (which stages are done, their steps).
+  const Distributed& group = Distributed::world();
+  if (group.leader()) std::filesystem::create_directories(top);
   for (size_t i = 0; i < stages.size(); ++i) {
     const std::string dir = stage_dir(top, i, stages[i]);
-    if (std::filesystem::exists(dir + "/eval.json")) {
+    if (group.any(group.leader() && std::filesystem::exists(dir + "/eval.json"))) {
       spdlog::info("stage {}/{} '{}' is done ({})", i + 1, stages.size(), stages[i].name, dir);
       continue;
     }
@@ -289,15 +310,16 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
       start = prev + (stages[i].from_policy ? "/policy.pt" : "/checkpoint.pt");
       // Continuing a checkpoint: the stage's own steps on top of those it has done.
       if (!stages[i].from_policy)
-        total = int64_t(eval_env_steps(prev + "/eval.json")) +
+        total = std::stoll(group.broadcast(group.leader() ? std::to_string(int64_t(eval_env_steps(prev + "/eval.json"))) : "")) +
                 SkillRecipe::read(stage_recipe(i, start, 0), top).ppo.total_steps;
     }
     const Recipe r = stage_recipe(i, start, total);
     spdlog::info("stage {}/{} '{}' in {}", i + 1, stages.size(), stages[i].name, dir);
     const int rc = train_skill(r, read_skill(r, top));
-    write_stage_metrics(top, stages);
+    if (group.leader()) write_stage_metrics(top, stages);
     if (rc != 0) return rc;
   }
+  if (!group.leader()) return 0;
   write_stage_metrics(top, stages);
   const std::string last = stage_dir(top, stages.size() - 1, stages.back());
   for (const char* f : {"policy.pt", "eval.json", "checkpoint.pt"})
@@ -309,26 +331,35 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
 
 int train_skill(const Recipe& recipe, const SkillRecipe& s) {
   const std::string recipe_path = recipe.file();
+  const Distributed& group = Distributed::world();
+  require_same_recipe(recipe);  // read whole by now: every key with its value or default
   const int threads = resolve_threads(s.threads);
   // LibTorch runs on one thread: the networks are too small to gain from more, and a
   // fixed thread count keeps floating-point sums, and so the trained policy, the same
   // whatever `threads` is. `threads` parallelises environment stepping only.
   set_torch_threads(1);
-  RunDir dir(s.run_dir, recipe.resolved_yaml(), recipe.defaulted_keys());
-  if (s.es) return train_es(s, recipe, recipe_path, dir, threads);
-  VectorEnv envs(s.make_env, s.ppo.num_envs, threads);
-  PPO ppo(s.ppo, s.net, envs, s.seed);
-  if (dir.has_checkpoint()) {
-    ppo.load(dir.checkpoint());
-    spdlog::info("resuming {} from iteration {} ({} steps)", dir.path(), ppo.iteration(), ppo.global_step());
+  // Rank 0 keeps the run directory; the other ranks learn from it whether to resume.
+  std::optional<RunDir> dir;
+  if (group.leader()) dir.emplace(s.run_dir, recipe.resolved_yaml(), recipe.defaulted_keys());
+  if (s.es) {
+    if (!group.single()) throw Error(recipe_path + ": key 'es': evolution strategies run on one process (drop --nproc)");
+    return train_es(s, recipe, recipe_path, *dir, threads);
+  }
+  const std::string checkpoint = s.run_dir + "/checkpoint.pt";
+  const Shard share = group.shard(s.ppo.num_envs, recipe_path + ": key 'ppo.num_envs'");
+  VectorEnv envs(s.make_env, share.count, threads, share.first);
+  PPO ppo(s.ppo, s.net, envs, s.seed, group);
+  if (group.any(dir && dir->has_checkpoint())) {
+    ppo.load(checkpoint);
+    spdlog::info("resuming {} from iteration {} ({} steps)", s.run_dir, ppo.iteration(), ppo.global_step());
   } else if (!s.init_from.empty()) {
     const std::string from = repo_path(s.init_from);
-    if (!std::filesystem::exists(from))
+    if (group.leader() && !std::filesystem::exists(from))
       throw Error(recipe_path + ": key 'init_from': no such checkpoint '" + s.init_from + "'");
     ppo.load(from, {}, /*resume_episodes=*/false);
     if (!std::isnan(s.init_log_std)) ppo.set_log_std(s.init_log_std);
     if (s.restart_lr_schedule) ppo.restart_lr_schedule();
-    spdlog::info("training {} in {} from {} (iteration {}, {} steps) to {} steps", s.task, dir.path(), s.init_from,
+    spdlog::info("training {} in {} from {} (iteration {}, {} steps) to {} steps", s.task, s.run_dir, s.init_from,
                  ppo.iteration(), ppo.global_step(), s.ppo.total_steps);
   } else if (!s.init_policy.empty()) {
     const std::string key = recipe_path + ": key 'init_policy': '" + s.init_policy + "'";
@@ -338,42 +369,50 @@ int train_skill(const Recipe& recipe, const SkillRecipe& s) {
     } catch (const Error& e) {
       throw Error(key + ": " + e.what());
     }
-    spdlog::info("training {} in {} with the actor of {} to {} steps", s.task, dir.path(), s.init_policy,
+    spdlog::info("training {} in {} with the actor of {} to {} steps", s.task, s.run_dir, s.init_policy,
                  s.ppo.total_steps);
+  } else if (group.single()) {
+    spdlog::info("training {} in {} ({} steps, {} threads)", s.task, s.run_dir, s.ppo.total_steps, threads);
   } else {
-    spdlog::info("training {} in {} ({} steps, {} threads)", s.task, dir.path(), s.ppo.total_steps, threads);
+    spdlog::info("training {} in {} ({} steps) on {} ranks, {} threads each", s.task, s.run_dir, s.ppo.total_steps,
+                 group.size(), threads);
   }
-  MetricsCsv csv(dir.file("metrics.csv"),
-                 {"iteration", "global_step", "episodes", "episode_return", "episode_length",
-                  "success_rate", "success_count", "policy_loss", "value_loss", "entropy",
-                  "approx_kl", "clip_fraction", "rollout_seconds", "update_seconds", "wall_seconds"},
-                 ppo.iteration());
+  std::optional<MetricsCsv> csv;
+  if (group.leader())
+    csv.emplace(dir->file("metrics.csv"),
+                std::vector<std::string>{"iteration", "global_step", "episodes", "episode_return", "episode_length",
+                                         "success_rate", "success_count", "policy_loss", "value_loss", "entropy",
+                                         "approx_kl", "clip_fraction", "rollout_seconds", "update_seconds",
+                                         "wall_seconds", "comm_seconds"},
+                ppo.iteration());
 
   const std::atomic<int>& stop = install_stop_signals();
-  Progress progress(s.task, s.ppo.total_steps, ppo.global_step());
+  std::optional<Progress> progress;
+  if (group.leader()) progress.emplace(s.task, s.ppo.total_steps, ppo.global_step());
   double recent_return = NAN, recent_success = NAN;
   while (ppo.global_step() < s.ppo.total_steps) {
     IterationStats st = ppo.iterate();
     if (st.episodes > 0) recent_return = st.episode_return, recent_success = st.success_rate;
-    csv.write({double(st.iteration), double(st.global_step), double(st.episodes), st.episode_return,
-               st.episode_length, st.success_rate, st.success_count, st.policy_loss, st.value_loss,
-               st.entropy, st.approx_kl, st.clip_fraction, st.rollout_seconds, st.update_seconds,
-               ppo.wall_seconds()});
-    bool last = ppo.global_step() >= s.ppo.total_steps;
-    if (last || stop || st.iteration % s.checkpoint_every == 0)
-      ppo.save(dir.checkpoint(), recipe.resolved_yaml());
-    progress.update(ppo.global_step(), recent_return, recent_success);
-    if (stop && !last) {
-      progress.finish();
+    if (csv)
+      csv->write({double(st.iteration), double(st.global_step), double(st.episodes), st.episode_return,
+                  st.episode_length, st.success_rate, st.success_count, st.policy_loss, st.value_loss,
+                  st.entropy, st.approx_kl, st.clip_fraction, st.rollout_seconds, st.update_seconds,
+                  ppo.wall_seconds(), st.comm_seconds});
+    const bool last = ppo.global_step() >= s.ppo.total_steps;
+    const bool stopping = group.any(stop != 0);  // every rank stops at the same iteration
+    if (last || stopping || st.iteration % s.checkpoint_every == 0) ppo.save(checkpoint, recipe.resolved_yaml());
+    if (progress) progress->update(ppo.global_step(), recent_return, recent_success);
+    if (stopping && !last) {
+      if (progress) progress->finish();
       spdlog::warn("interrupted: checkpoint saved at iteration {}; rerun the same command to resume",
                    ppo.iteration());
-      return 128 + stop;
+      return 128 + (stop ? stop.load() : SIGTERM);
     }
   }
-  progress.finish();
+  if (progress) progress->finish();
   uninstall_stop_signals();
-
-  return finish_run(ppo.policy(), s, dir, ppo.global_step(), ppo.wall_seconds(), threads);
+  if (!group.leader()) return 0;  // rank 0 exports and evaluates
+  return finish_run(ppo.policy(), s, *dir, ppo.global_step(), ppo.wall_seconds(), threads);
 }
 
 }  // namespace

@@ -1,0 +1,241 @@
+// Data-parallel PPO on c10d Gloo, on loopback: two ranks with half the environments each
+// train what one process with all of them trains; a killed rank resumes; bad launches are
+// refused in one line.
+#include <gtest/gtest.h>
+#include <torch/torch.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+#include <thread>
+
+#include "core/distributed.h"
+#include "tests/cli_run.h"
+#include "tests/temp_dir.h"
+
+namespace segue {
+namespace {
+
+std::vector<std::vector<std::string>> csv(const std::string& path) {
+  std::vector<std::vector<std::string>> rows;
+  std::ifstream in(path);
+  for (std::string line; std::getline(in, line);) {
+    std::vector<std::string> row;
+    std::stringstream ss(line);
+    for (std::string cell; std::getline(ss, cell, ',');) row.push_back(cell);
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+bool timing(const std::string& column) { return column.find("seconds") != std::string::npos; }
+
+// Every tensor of two checkpoints, to `tol`: networks, normalisers, episodes in flight
+// and, under "optimizer", Adam's moments; the recipe text and the counters (which hold
+// wall time) aside. Returns how many tensors were compared.
+bool close(const torch::Tensor& a, const torch::Tensor& b, double tol) {
+  if (a.sizes() != b.sizes()) return false;
+  if (!a.is_floating_point()) return torch::equal(a, b);
+  return torch::allclose(a.to(torch::kFloat64), b.to(torch::kFloat64), tol, tol);
+}
+
+// LibTorch keys Adam's per-parameter state by the parameter's address, which differs
+// between processes: each state of one file must match a state of the other.
+bool same_state(torch::serialize::InputArchive& a, torch::serialize::InputArchive& b, double tol) {
+  for (const char* k : {"exp_avg", "exp_avg_sq"}) {
+    torch::Tensor ta, tb;
+    if (!a.try_read(k, ta) || !b.try_read(k, tb) || !close(ta, tb, tol)) return false;
+  }
+  return true;
+}
+
+int expect_close_archives(torch::serialize::InputArchive& a, torch::serialize::InputArchive& b,
+                          const std::string& where, double tol) {
+  int compared = 0;
+  for (const std::string& key : a.keys()) {
+    if (key == "meta_note" || key == "meta_counters") continue;
+    torch::Tensor ta, tb;
+    torch::serialize::InputArchive sa, sb;
+    if (a.try_read(key, ta)) {
+      EXPECT_TRUE(b.try_read(key, tb)) << where << key;
+      EXPECT_TRUE(close(ta, tb, tol)) << where << key << " differs";
+      ++compared;
+    } else if (key.rfind("0x", 0) == 0 && a.try_read(key, sa)) {
+      bool matched = false;
+      for (const std::string& other : b.keys())
+        if (b.try_read(other, sb) && same_state(sa, sb, tol)) matched = true;
+      EXPECT_TRUE(matched) << where << key << ": no Adam state of the other file matches";
+      compared += 2;
+    } else if (a.try_read(key, sa)) {
+      EXPECT_TRUE(b.try_read(key, sb)) << where << key;
+      compared += expect_close_archives(sa, sb, where + key + "/", tol);
+    }
+  }
+  return compared;
+}
+
+int free_port() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t len = sizeof a;
+  ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len);
+  ::close(fd);
+  return ntohs(a.sin_port);
+}
+
+class DataParallel : public TempDirTest {
+ protected:
+  DataParallel() : TempDirTest("distributed") {}
+  // A 50-step walk, 4 environments; minibatches of half a rollout, so that every
+  // minibatch mixes both ranks' rows.
+  std::string recipe(const std::string& name, int iterations, int epochs = 2, int steps_per_env = 64,
+                     int minibatches = 2) {
+    const std::string file = path(name + ".yaml");
+    std::ofstream(file) << "task: walker_forward\n"
+                           "threads: 1\n"
+                           "run_dir: " << path(name) << "\n"
+                           "checkpoint_every: 1\n"
+                           "env: {max_episode_steps: 50, success_steps: 50}\n"
+                           "ppo: {total_steps: " << iterations * 4 * steps_per_env
+                        << ", num_envs: 4, steps_per_env: " << steps_per_env
+                        << ", minibatch_size: " << 4 * steps_per_env / minibatches << ", epochs: " << epochs << "}\n"
+                           "eval: {episodes: 1}\n";
+    return file;
+  }
+  std::string train(const std::string& file, const std::string& flags = "") {
+    CliRun r = run_cli("train " + file + " " + flags);
+    EXPECT_EQ(r.code, 0) << r.output;
+    return r.output;
+  }
+};
+
+TEST_F(DataParallel, TwoRanksTrainWhatOneProcessTrains) {
+  // One iteration of one minibatch: Adam's first moments are 0.1 x the (clipped) gradient,
+  // so equal optimiser states after it are equal gradients. Then three iterations.
+  for (int iterations : {1, 3}) {
+    const std::string one = "one" + std::to_string(iterations), two = "two" + std::to_string(iterations);
+    const int epochs = iterations == 1 ? 1 : 2, minibatches = iterations == 1 ? 1 : 2;
+    const std::string r1 = recipe(one, iterations, epochs, 64, minibatches);
+    const std::string r2 = recipe(two, iterations, epochs, 64, minibatches);
+    train(r1);
+    const std::string out = train(r2, "--nproc 2");
+    EXPECT_NE(out.find("on 2 ranks"), std::string::npos) << out;
+    torch::serialize::InputArchive a, b;
+    a.load_from(path(one) + "/checkpoint.pt");
+    b.load_from(path(two) + "/checkpoint.pt");
+    EXPECT_GT(expect_close_archives(a, b, "checkpoint.pt: ", 2e-5), 40);  // networks, normalisers, episodes in flight, optimiser moments
+    auto m1 = csv(path(one) + "/metrics.csv"), m2 = csv(path(two) + "/metrics.csv");
+    ASSERT_EQ(m1.size(), size_t(iterations + 1));
+    ASSERT_EQ(m1.size(), m2.size());
+    for (size_t r = 1; r < m1.size(); ++r)
+      for (size_t c = 0; c < m1[0].size(); ++c)
+        if (!timing(m1[0][c]))
+          EXPECT_NEAR(std::stod(m1[r][c]), std::stod(m2[r][c]), 1e-5 * (1 + std::abs(std::stod(m1[r][c]))))
+              << "row " << r << " column " << m1[0][c];
+  }
+}
+
+// The children of a process (the launcher's ranks), in start order.
+std::vector<pid_t> children(pid_t pid) {
+  std::ifstream in("/proc/" + std::to_string(pid) + "/task/" + std::to_string(pid) + "/children");
+  std::vector<pid_t> out;
+  for (pid_t c; in >> c;) out.push_back(c);
+  return out;
+}
+
+TEST_F(DataParallel, AKilledRankStopsTheOthersAndTheRerunResumesToTheUnbrokenRun) {
+  const int iterations = 24;
+  train(recipe("unbroken", iterations, 2, 128), "--nproc 2");
+  const std::string file = recipe("killed", iterations, 2, 128);
+  const pid_t launcher = fork();
+  if (launcher == 0) {
+    freopen("/dev/null", "w", stdout);
+    freopen("/dev/null", "w", stderr);
+    execl(SEGUE_BINARY, SEGUE_BINARY, "train", file.c_str(), "--nproc", "2", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Rank 1 dies (SIGKILL: no checkpoint of its own) once a few iterations are in.
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (csv(path("killed") + "/metrics.csv").size() < 4 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const std::vector<pid_t> ranks = children(launcher);
+  ASSERT_EQ(ranks.size(), 2u);
+  ::kill(ranks[1], SIGKILL);
+  int status = 0;
+  ::waitpid(launcher, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_NE(WEXITSTATUS(status), 0);
+  const size_t rows_then = csv(path("killed") + "/metrics.csv").size() - 1;
+  ASSERT_LT(rows_then, size_t(iterations)) << "the run ended before rank 1 was killed";
+  EXPECT_FALSE(std::filesystem::exists(path("killed") + "/eval.json"));
+
+  const std::string out = train(file, "--nproc 2");
+  EXPECT_NE(out.find("resuming"), std::string::npos) << out;
+  // The same rows (timings aside) and the same policy as the run nobody killed.
+  auto a = csv(path("unbroken") + "/metrics.csv"), b = csv(path("killed") + "/metrics.csv");
+  ASSERT_EQ(a.size(), size_t(iterations + 1));
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t r = 0; r < a.size(); ++r)
+    for (size_t c = 0; c < a[0].size(); ++c)
+      if (!timing(a[0][c])) EXPECT_EQ(a[r][c], b[r][c]) << "row " << r << " column " << a[0][c];
+  torch::serialize::InputArchive ca, cb;
+  ca.load_from(path("unbroken") + "/checkpoint.pt");
+  cb.load_from(path("killed") + "/checkpoint.pt");
+  EXPECT_GT(expect_close_archives(ca, cb, "checkpoint.pt: ", 0.0), 40);
+}
+
+TEST_F(DataParallel, BadLaunchesAreRefusedInOneLine) {
+  const std::string file = recipe("bad", 1);
+  struct Case {
+    std::string command, expect;
+  };
+  // A port that is taken: rank 0 cannot serve the rendezvous there.
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in addr{};
+  addr.sin_family = AF_INET;
+  addr.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  socklen_t len = sizeof addr;
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof addr), 0);
+  ASSERT_EQ(::listen(fd, 1), 0);
+  ::getsockname(fd, reinterpret_cast<sockaddr*>(&addr), &len);
+  const std::string taken = std::to_string(ntohs(addr.sin_port));
+  const std::string port = std::to_string(free_port());
+  // run_cli puts the binary first: "--help >/dev/null;" lets a case start with its own environment.
+  const std::string bin = SEGUE_BINARY;
+  auto own = [](const std::string& shell) { return "--help >/dev/null; { " + shell + "; }"; };
+  const std::vector<Case> cases{
+      {"train " + file + " --nproc 0", "--nproc must be an integer in [1, 256], got '0'"},
+      {"train " + file + " --nproc", "flag --nproc needs a value"},
+      {"run " + file + " --nproc 2", "--nproc is for 'segue train'"},
+      {own("MASTER_PORT=" + taken + " " + bin + " train " + file + " --nproc 2"),
+       "MASTER_PORT " + taken + " (in use? pick another MASTER_PORT)"},
+      {own("RANK=1 " + bin + " train " + file), "RANK is set but WORLD_SIZE is not"},
+      {own("WORLD_SIZE=2 RANK=5 " + bin + " train " + file),
+       "RANK must be an integer in [0, 1], got '5'"},
+      // Rank 1 started with another learning rate than rank 0: both refuse, naming the key.
+      {own("export WORLD_SIZE=2 MASTER_PORT=" + port + "; RANK=0 " + bin + " train " + file + " & RANK=1 " + bin +
+           " train " + file + " --set ppo.lr=1e-4; wait $!"),
+       "rank 1 was started with another recipe than rank 0 (key 'ppo.lr': "},
+  };
+  for (const Case& c : cases) {
+    CliRun r = run_cli(c.command);
+    EXPECT_NE(r.code, 0) << c.command;
+    EXPECT_NE(r.output.find(c.expect), std::string::npos) << c.command << "\n" << r.output;
+    EXPECT_EQ(r.output.find("terminate called"), std::string::npos) << r.output;
+  }
+  EXPECT_FALSE(std::filesystem::exists(path("bad") + "/eval.json"));  // nothing trained
+  ::close(fd);
+}
+
+}  // namespace
+}  // namespace segue
