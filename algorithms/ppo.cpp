@@ -244,25 +244,38 @@ void PPO::update(IterationStats& stats) {
   auto ret = torch::from_blob(buf_.returns.data(), {T * N});
   const auto& spec = envs_.spec();
   auto low = torch::tensor(spec.act_low), high = torch::tensor(spec.act_high);
+  // Every rank draws the same permutations, whatever a reward hook drew before.
+  torch::manual_seed(mix_seed(seed_, 2 * iteration_ + 2) ^ 0x9e3779b9ULL);
   int batches = 0;
   double sums[4] = {0, 0, 0, 0};  // policy, value, approx_kl, clip_fraction, weighted by rows
+  std::vector<torch::Tensor> minibatch, advs;  // this rank's rows of each minibatch of an epoch, their A
+  std::vector<double> rows, moments;      // each minibatch's rows over every rank; sum and sum of squares of A
   for (int epoch = 0; epoch < cfg_.epochs; ++epoch) {
     auto perm = torch::randperm(M, torch::kLong);
+    minibatch.clear(), advs.clear(), rows.clear(), moments.clear();
     for (int64_t start = 0; start < M; start += mb) {
       auto idx = perm.slice(0, start, std::min(start + mb, M));
-      const double rows = double(idx.numel());
+      rows.push_back(double(idx.numel()));
       if (!group_.single()) {
         // Row t * global_envs + e of the whole rollout is row t * N + (e - first) here.
         auto t = idx.div(global_envs_, "floor"), e = idx.remainder(global_envs_) - first;
         idx = (t * N + e).masked_select((e >= 0) & (e < N));
       }
-      const double share = double(idx.numel()) / rows;  // this rank's part of the minibatch
       auto a = adv.index_select(0, idx).to(torch::kFloat64);
-      // Advantages normalised over the whole minibatch (every rank's rows).
-      double moments[2] = {a.sum().item<double>(), a.pow(2).sum().item<double>()};
-      group_.sum(moments, 2);
-      const double mean = moments[0] / rows;
-      const double std = std::sqrt(std::max(moments[1] - rows * mean * mean, 0.0) / std::max(rows - 1.0, 1.0));
+      moments.push_back(a.sum().item<double>());
+      moments.push_back(a.pow(2).sum().item<double>());
+      minibatch.push_back(idx);
+      advs.push_back(a);
+    }
+    // Advantages are normalised over each whole minibatch, every rank's rows: one
+    // exchange per epoch.
+    group_.sum(moments.data(), moments.size());
+    for (size_t j = 0; j < minibatch.size(); ++j) {
+      const torch::Tensor& idx = minibatch[j];
+      const double n = rows[j], mean = moments[2 * j] / n;
+      const double std = std::sqrt(std::max(moments[2 * j + 1] - n * mean * mean, 0.0) / std::max(n - 1.0, 1.0));
+      const double share = double(idx.numel()) / n;  // this rank's part of the minibatch
+      const torch::Tensor& a = advs[j];
       optimizer_->zero_grad();
       double local = 0.0;
       if (idx.numel() > 0) {
@@ -282,7 +295,7 @@ void PPO::update(IterationStats& stats) {
         sums[2] += loss.approx_kl.item<double>() * share;
         sums[3] += loss.clip_fraction.item<double>() * share;
       }
-      const double total = sum_gradients(local);
+      const double total = group_.sum_gradients(net_->parameters(), local);
       if (!std::isfinite(total))
         throw Error("PPO loss became " + std::to_string(total) + " at iteration " +
                     std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
@@ -303,24 +316,6 @@ void PPO::update(IterationStats& stats) {
   stats.clip_fraction = sums[3] / batches;
   stats.entropy = net_->entropy().item<double>();
   refresh_inference_copy();
-}
-
-double PPO::sum_gradients(double loss) {
-  if (group_.single()) return loss;
-  std::vector<torch::Tensor> parts;
-  auto params = net_->parameters();
-  for (auto& p : params) parts.push_back(p.grad().defined() ? p.grad().reshape(-1) : torch::zeros({p.numel()}));
-  parts.push_back(torch::tensor({float(loss)}));
-  auto flat = torch::cat(parts);
-  group_.sum(flat);
-  int64_t k = 0;
-  for (auto& p : params) {
-    auto g = flat.slice(0, k, k + p.numel()).view(p.sizes());
-    if (p.grad().defined()) p.mutable_grad().copy_(g);
-    else p.mutable_grad() = g.clone();
-    k += p.numel();
-  }
-  return flat[k].item<double>();
 }
 
 torch::Tensor PPO::log_prob(const float* raw_obs, const float* actions, int64_t n) {

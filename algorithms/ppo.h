@@ -95,6 +95,7 @@ class PPO {
   double wall_seconds() const { return wall_seconds_; }  // training time, across resumes
   int64_t total_iterations() const;
   ActorCritic& net() { return net_; }
+  const Distributed& group() const { return group_; }
 
   // log pi(a|s) of the current policy at raw (unnormalised) observations, no gradient:
   // AIRL's D needs the generator's density at the expert's actions (Eq. 2).
@@ -135,9 +136,6 @@ class PPO {
   struct InFlight;
   void sample_actions(int t);
   void refresh_inference_copy();
-  // Sums every parameter's gradient over the ranks, with `loss` (this rank's share of
-  // the minibatch loss) riding along; returns the whole minibatch's loss.
-  double sum_gradients(double loss);
   // The networks' input for one raw observation: normalised, then the periodic features.
   void net_input(const float* raw, float* out) const;
 

@@ -208,6 +208,33 @@ void Distributed::barrier() const {
   run("barrier", [&] { wait_for(group_->gloo->barrier(c10d::BarrierOptions{})); });
 }
 
+double Distributed::sum_gradients(const std::vector<torch::Tensor>& params, double extra) const {
+  if (single()) return extra;
+  std::vector<torch::Tensor> parts;
+  for (const auto& p : params) parts.push_back(p.grad().defined() ? p.grad().reshape(-1) : torch::zeros({p.numel()}));
+  parts.push_back(torch::tensor({float(extra)}));
+  auto flat = torch::cat(parts);
+  sum(flat);
+  int64_t k = 0;
+  for (auto p : params) {
+    auto g = flat.slice(0, k, k + p.numel()).view(p.sizes());
+    if (p.grad().defined()) p.mutable_grad().copy_(g);
+    else p.mutable_grad() = g.clone();
+    k += p.numel();
+  }
+  return flat[k].item<double>();
+}
+
+void Distributed::leader_done(const std::string& what) const {
+  if (single()) return;
+  static int calls = 0;
+  const std::string key = "segue/leader_done/" + std::to_string(calls++);
+  run(what.c_str(), [&] {
+    if (leader()) group_->store->set(key, std::vector<uint8_t>{1});
+    else group_->store->wait({key}, std::chrono::hours(24 * 365));
+  });
+}
+
 // ---- the local launcher --------------------------------------------------------------
 
 namespace {

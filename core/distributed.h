@@ -53,6 +53,13 @@ class Distributed {
   // Every rank's bytes, in rank order, on every rank.
   std::vector<std::string> gather(const std::string& bytes) const;
   void barrier() const;
+  // Sums every parameter's gradient over the ranks (a parameter without one counts as
+  // zero), with `extra` riding along in the same exchange; returns the sum of `extra`.
+  double sum_gradients(const std::vector<torch::Tensor>& params, double extra = 0.0) const;
+  // Work rank 0 does alone (a stage whose output only it writes): the others wait at
+  // leader_done() until rank 0 reaches it, without SEGUE_DIST_TIMEOUT (but a rank 0 that
+  // dies still ends the wait). Every rank calls it, in the same order.
+  void leader_done(const std::string& what) const;
 
   // Wall time spent inside collectives since the start (benchmarks report it).
   double comm_seconds() const { return comm_seconds_; }

@@ -16,7 +16,6 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
                                  const std::atomic<int>* stop) {
   auto env = r.make_env();
   const EnvSpec& spec = env->spec();
-  const Transition& tr = r.meta.transitions().at(transition);
   bool any_q = false;
   for (const auto& a : trained) any_q |= bool(a.q);
   TransitionController controller(r.skills, r.meta, trained, any_q ? SwitchRule::QNetwork : SwitchRule::IntervalEnd);

@@ -33,6 +33,10 @@ struct StartStates {
   void state(int i, std::vector<double>& out) const {
     out.assign(states.begin() + size_t(i) * state_dim, states.begin() + size_t(i + 1) * state_dim);
   }
+  void append(const StartStates& o) {
+    states.insert(states.end(), o.states.begin(), o.states.end());
+    obs.insert(obs.end(), o.obs.begin(), o.obs.end());
+  }
   // Keeps the first n states (all if there are fewer).
   void keep_first(int n) {
     n = std::max(0, std::min(n, size()));

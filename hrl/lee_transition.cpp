@@ -62,9 +62,10 @@ StepResult LeeTransitionEnv::step(const float* action, float* obs) {
 }
 
 LeeTrainer::LeeTrainer(const TransitionPolicyConfig& tp, const LeeConfig& c, VectorEnv& envs,
-                       const Demonstrations& expert, const Policy& next, uint64_t seed)
+                       const Demonstrations& expert, const Policy& next, uint64_t seed,
+                       const Distributed& group)
     : cfg_(c), envs_(envs),
-      ppo_(tp.ppo, tp.network(envs.spec(), next), envs, seed),
+      ppo_(tp.ppo, tp.network(envs.spec(), next), envs, seed, group),
       obs_dim_(envs.spec().obs_dim) {
   if (expert.obs_dim != obs_dim_) throw Error("Lee transition policy: T_b's observation size differs from pi_b's");
   if (tp.init_from_next) ppo_.init_actor(next, c.termination_bias);
@@ -109,8 +110,11 @@ void LeeTrainer::reward(RolloutBuffer& buf) {
       for (int t = 0; t < T; ++t) add(&e.states[size_t(t) * obs_dim_], labels[t]);
       ++episodes, successes += e.success;
     }
+  const Distributed& group = ppo_.group();
+  double counts[2] = {double(episodes), double(successes)};
+  group.sum(counts, 2);
   last_ = Stats();
-  if (episodes) last_.handover_success = double(successes) / episodes;
+  if (counts[0] > 0) last_.handover_success = counts[1] / counts[0];
   const int64_t np = std::min<int64_t>(pos_n_, cfg_.max_rows), nn = std::min<int64_t>(neg_n_, cfg_.max_rows);
   auto pos = torch::from_blob(pos_.data(), {np, int64_t(obs_dim_)});
   auto pos_y = torch::from_blob(pos_label_.data(), {np});
@@ -125,9 +129,9 @@ void LeeTrainer::reward(RolloutBuffer& buf) {
     }
     auto loss = p_->loss(x, y);
     opt_->zero_grad();
-    loss.backward();
+    (loss / double(group.size())).backward();
+    last_.predictor_loss += group.sum_gradients(p_->parameters(), loss.item<double>() / group.size()) / cfg_.steps;
     opt_->step();
-    last_.predictor_loss += loss.item<double>() / cfg_.steps;
   }
   // 2. Rewards P(s_{t+1}) - P(s_t), plus P(s_T) where the episode ends.
   torch::NoGradGuard no_grad;

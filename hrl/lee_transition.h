@@ -52,8 +52,11 @@ class LeeTransitionEnv : public Env {
 class LeeTrainer {
  public:
   // `envs` are LeeTransitionEnvs; `expert` is T_b (its states are P_b's label-1 data).
+  // With `group`, PPO is data-parallel (ppo.h) and P_b's gradients are averaged over the
+  // ranks, each labelling its own episodes.
   LeeTrainer(const TransitionPolicyConfig& tp, const LeeConfig& config, VectorEnv& envs,
-             const Demonstrations& expert, const Policy& next, uint64_t seed);
+             const Demonstrations& expert, const Policy& next, uint64_t seed,
+             const Distributed& group = Distributed::alone());
   struct Stats {
     IterationStats ppo;
     double predictor_loss = 0, handover_success = NAN;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <sstream>
 
 #include "core/progress.h"
@@ -66,19 +67,45 @@ Demonstrations demonstrations_of(const CompositeRecipe& r, int t, const std::str
 }
 
 // Returns the signal number when stopped (nothing of the unfinished set is kept), else 0.
+// With several ranks each collects its share (its own episode seeds) into FILE.partR,
+// and rank 0 joins the parts in rank order into FILE.
+template <class Items, class Collect>
+int collect_shared(const Distributed& group, const std::string& file, int count, uint64_t seed,
+                   const std::atomic<int>* stop, Collect collect, Items (*load)(const std::string&)) {
+  const Shard share = group.shard(count, file);
+  Items items = collect(share.count, group.single() ? seed : mix_seed(seed, 0xc011 + group.rank()));
+  if (const int sig = group.any(signal_of(stop) != 0) ? std::max(signal_of(stop), 1) : 0) return sig;
+  if (group.single()) {
+    save(items, file);
+    return 0;
+  }
+  const std::string part = file + ".part" + std::to_string(group.rank());
+  save(items, part);
+  group.barrier();
+  if (group.leader()) {
+    Items all = load(file + ".part0");
+    for (int r = 1; r < group.size(); ++r) all.append(load(file + ".part" + std::to_string(r)));
+    save(all, file);
+    for (int r = 0; r < group.size(); ++r) fs::remove(file + ".part" + std::to_string(r));
+  }
+  group.leader_done("collection");
+  return 0;
+}
+
 int collect(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
-            const std::atomic<int>* stop) {
+            const std::atomic<int>* stop, const Distributed& group) {
   const CollectConfig& c = r.pipeline.collect;
-  if (!exists(dir + "/start_states.pt")) {
+  if (!group.any(group.leader() && exists(dir + "/start_states.pt"))) {
     const int count = r.start_state_count(t);
     spdlog::info("  collecting S_a: {} states where the interval begins", count);
-    StartStates s = collect_start_states(r, t, count, mix_seed(r.pipeline.seed, 2 * t),
-                                         load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false),
-                                         kStartStateEpisodes, stop);
-    if (int sig = signal_of(stop)) return sig;
-    save(s, dir + "/start_states.pt");
+    const auto trained = load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false);
+    if (int sig = collect_shared<StartStates>(
+            group, dir + "/start_states.pt", count, mix_seed(r.pipeline.seed, 2 * t), stop,
+            [&](int n, uint64_t seed) { return collect_start_states(r, t, n, seed, trained, kStartStateEpisodes, stop); },
+            load_start_states))
+      return sig;
   }
-  if (!exists(dir + "/demonstrations.pt")) {
+  if (!group.any(group.leader() && exists(dir + "/demonstrations.pt"))) {
     const Transition& tr = r.meta.transitions()[t];
     if (tr.expert_after_handover)
       spdlog::info("  collecting T_b: at most {} steps of pi_b in its window, taking over at S_a's states",
@@ -96,10 +123,12 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
       handovers = starts_of(r, t, dir);
       handovers.keep_first(handovers.size() - r.pipeline.switching.validation_starts);
     }
-    Demonstrations d = collect_demonstrations(r, t, c.demonstrations, mix_seed(r.pipeline.seed, 2 * t + 1),
-                                              kDemonstrationEpisodes, stop, &handovers);
-    if (int sig = signal_of(stop)) return sig;
-    save(d, dir + "/demonstrations.pt");
+    return collect_shared<Demonstrations>(
+        group, dir + "/demonstrations.pt", c.demonstrations, mix_seed(r.pipeline.seed, 2 * t + 1), stop,
+        [&](int n, uint64_t seed) {
+          return collect_demonstrations(r, t, n, seed, kDemonstrationEpisodes, stop, &handovers);
+        },
+        load_demonstrations);
   }
   return 0;
 }
@@ -107,33 +136,41 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
 // PPO iterations of `trainer` (a TransitionPolicyTrainer or LeeTrainer) to the budget,
 // with checkpoints; `row` turns an iteration's stats into its CSV row. Returns the signal
 // number when stopped, else 0.
+// With several ranks, rank 0 writes the CSV and reports; all stop at the same iteration.
 template <class Trainer, class Row>
 int train_loop(Trainer& trainer, const CompositeRecipe& r, int64_t total_steps, const std::string& label,
-               const std::string& ckpt, MetricsCsv& csv, const PipelineOptions& o, Row row) {
-  Progress progress(label, total_steps, trainer.ppo().global_step());
+               const std::string& ckpt, const std::string& csv_path, const std::vector<std::string>& columns,
+               const PipelineOptions& o, Row row) {
+  const Distributed& group = *o.group;
+  std::optional<MetricsCsv> csv;
+  std::optional<Progress> progress;
+  if (group.leader()) {
+    csv.emplace(csv_path, columns, trainer.ppo().iteration());
+    progress.emplace(label, total_steps, trainer.ppo().global_step());
+  }
   double recent = NAN;
   while (trainer.ppo().global_step() < total_steps) {
     auto s = trainer.iterate();
     if (s.ppo.episodes > 0) recent = s.ppo.success_rate;
-    csv.write(row(s));
+    if (csv) csv->write(row(s));
     bool last = trainer.ppo().global_step() >= total_steps;
-    int stop = signal_of(o.stop);
+    const int stop = group.any(signal_of(o.stop) != 0) ? std::max(signal_of(o.stop), 1) : 0;
     if (last || stop || s.ppo.iteration % 10 == 0) trainer.save(ckpt, r.resolved);
-    progress.update(trainer.ppo().global_step(), s.ppo.episode_return, recent);
+    if (progress) progress->update(trainer.ppo().global_step(), s.ppo.episode_return, recent);
     if (stop && !last) {
-      progress.finish();
+      if (progress) progress->finish();
       return stop;
     }
   }
-  progress.finish();
+  if (progress) progress->finish();
   spdlog::info("  {}: {} steps in {}; success {:.0f}% in its last episodes", label, trainer.ppo().global_step(),
                format_duration(trainer.ppo().wall_seconds()), 100 * recent);
   return 0;
 }
 
 template <class Trainer>
-void resume(Trainer& trainer, const std::string& ckpt) {
-  if (!exists(ckpt)) return;
+void resume(Trainer& trainer, const std::string& ckpt, const Distributed& group) {
+  if (!group.any(group.leader() && exists(ckpt))) return;
   trainer.load(ckpt);
   spdlog::info("  resuming from iteration {} ({} steps)", trainer.ppo().iteration(), trainer.ppo().global_step());
 }
@@ -144,26 +181,28 @@ int train_transition(const CompositeRecipe& r, int t, const std::string& dir, co
   const Transition& tr = r.meta.transitions()[t];
   const Skill& b = r.skills[tr.to];
   StartStates starts = starts_of(r, t, dir);
+  const Shard share = o.group->shard(cfg.ppo.num_envs, "transition.ppo.num_envs");
   VectorEnv envs(
       [&] { return std::make_unique<TransitionEnv>(r.make_env(), starts, tr.training_window(), b.obs_begin, b.obs_end); },
-      cfg.ppo.num_envs, o.threads);
+      share.count, o.threads, share.first);
   TransitionPolicyTrainer trainer(cfg, envs, demonstrations_of(r, t, dir), b.policy,
-                                  mix_seed(r.pipeline.seed, 100 + t));
+                                  mix_seed(r.pipeline.seed, 100 + t), *o.group);
   const std::string ckpt = dir + "/transition_checkpoint.pt";
-  resume(trainer, ckpt);
-  MetricsCsv csv(dir + "/transition.csv",
-                 {"iteration", "global_step", "episodes", "interval_completed", "episode_length", "airl_reward",
-                  "disc_loss", "expert_accuracy", "generator_accuracy", "policy_loss", "value_loss", "approx_kl",
-                  "wall_seconds"},
-                 trainer.ppo().iteration());
-  int stop = train_loop(trainer, r, cfg.ppo.total_steps, r.transition_name(t) + " pi_ab", ckpt, csv, o,
+  resume(trainer, ckpt, *o.group);
+  int stop = train_loop(trainer, r, cfg.ppo.total_steps, r.transition_name(t) + " pi_ab", ckpt,
+                        dir + "/transition.csv",
+                        {"iteration", "global_step", "episodes", "interval_completed", "episode_length", "airl_reward",
+                         "disc_loss", "expert_accuracy", "generator_accuracy", "policy_loss", "value_loss", "approx_kl",
+                         "wall_seconds"},
+                        o,
                         [&](const TransitionIterationStats& s) -> std::vector<double> {
                           return {double(s.ppo.iteration), double(s.ppo.global_step), double(s.ppo.episodes),
                                   s.ppo.success_rate, s.ppo.episode_length, s.airl_reward, s.disc_loss,
                                   s.expert_accuracy, s.generator_accuracy, s.ppo.policy_loss, s.ppo.value_loss,
                                   s.ppo.approx_kl, trainer.ppo().wall_seconds()};
                         });
-  if (!stop) export_artefact(trainer.policy(), r, t, dir, "policy.pt");
+  if (!stop && o.group->leader()) export_artefact(trainer.policy(), r, t, dir, "policy.pt");
+  if (!stop) o.group->leader_done("export of pi_ab");
   return stop;
 }
 
@@ -173,52 +212,64 @@ int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const Pip
   const Skill& b = r.skills[r.meta.transitions()[t].to];
   StartStates starts = starts_of(r, t, dir);
   const int subtask_steps = r.pipeline.switching.max_subtask_steps;
-  VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r, t, starts, subtask_steps); }, cfg.ppo.num_envs,
-                 o.threads);
+  const Shard share = o.group->shard(cfg.ppo.num_envs, "transition.ppo.num_envs");
+  VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r, t, starts, subtask_steps); }, share.count,
+                 o.threads, share.first);
   LeeTrainer trainer(cfg, r.pipeline.lee, envs, demonstrations_of(r, t, dir), b.policy,
-                     mix_seed(r.pipeline.seed, 300 + t));
+                     mix_seed(r.pipeline.seed, 300 + t), *o.group);
   const std::string ckpt = dir + "/lee_checkpoint.pt";
-  resume(trainer, ckpt);
-  MetricsCsv csv(dir + "/lee.csv",
-                 {"iteration", "global_step", "episodes", "handover_success", "episode_length", "predictor_loss",
-                  "policy_loss", "value_loss", "approx_kl", "wall_seconds"},
-                 trainer.ppo().iteration());
-  int stop = train_loop(trainer, r, cfg.ppo.total_steps, r.transition_name(t) + " Lee", ckpt, csv, o,
+  resume(trainer, ckpt, *o.group);
+  int stop = train_loop(trainer, r, cfg.ppo.total_steps, r.transition_name(t) + " Lee", ckpt, dir + "/lee.csv",
+                        {"iteration", "global_step", "episodes", "handover_success", "episode_length", "predictor_loss",
+                         "policy_loss", "value_loss", "approx_kl", "wall_seconds"},
+                        o,
                         [&](const LeeTrainer::Stats& s) -> std::vector<double> {
                           return {double(s.ppo.iteration), double(s.ppo.global_step), double(s.ppo.episodes),
                                   s.handover_success, s.ppo.episode_length, s.predictor_loss, s.ppo.policy_loss,
                                   s.ppo.value_loss, s.ppo.approx_kl, trainer.ppo().wall_seconds()};
                         });
-  if (!stop) export_artefact(trainer.policy(), r, t, dir, "lee.pt");
+  if (!stop && o.group->leader()) export_artefact(trainer.policy(), r, t, dir, "lee.pt");
+  if (!stop) o.group->leader_done("export of Lee's policy");
   return stop;
 }
 
 // Reports and checkpoints every tenth of the attempts (at most 100), so that a stopped
 // stage resumes where it was; the checkpoint goes once q.pt is written. Returns the
 // signal number when stopped, else 0.
+// With several ranks the attempts are split between them (SwitchTrainer); rank 0 writes
+// and chooses the margin while the others wait.
 int train_switch(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
-                 const std::atomic<int>* stop) {
+                 const std::atomic<int>* stop, const Distributed& group) {
   const SwitchConfig& cfg = r.pipeline.switching;
   SwitchTrainer trainer(cfg, r, t, starts_of(r, t, dir), Policy::load(dir + "/policy.pt"),
                         load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false),
-                        mix_seed(r.pipeline.seed, 200 + t));
+                        mix_seed(r.pipeline.seed, 200 + t), group);
   const std::string ckpt = dir + "/switch_checkpoint.pt";
   const int chunk = std::clamp(cfg.attempts / 10, 1, 100);
-  if (exists(ckpt)) {
+  if (group.any(group.leader() && exists(ckpt))) {
     trainer.load(ckpt);
     spdlog::info("  resuming from attempt {}", trainer.attempts_done());
   }
-  MetricsCsv csv(dir + "/switch.csv", {"attempts", "epsilon", "subtask_success", "switch_step", "loss", "env_steps", "wall_seconds"},
-                 (trainer.attempts_done() + chunk - 1) / chunk);
+  std::optional<MetricsCsv> csv;
+  if (group.leader())
+    csv.emplace(dir + "/switch.csv",
+                std::vector<std::string>{"attempts", "epsilon", "subtask_success", "switch_step", "loss", "env_steps",
+                                         "wall_seconds", "replay_rows", "rank0_rows"},
+                (trainer.attempts_done() + chunk - 1) / chunk);
   while (trainer.attempts_done() < cfg.attempts) {
     SwitchStats s = trainer.run(std::min(chunk, cfg.attempts - trainer.attempts_done()));
-    csv.write({double(trainer.attempts_done()), s.epsilon, s.success_rate, s.switch_step, s.loss,
-               double(trainer.env_steps()), trainer.wall_seconds()});
+    if (csv)
+      csv->write({double(trainer.attempts_done()), s.epsilon, s.success_rate, s.switch_step, s.loss,
+                  double(trainer.env_steps()), trainer.wall_seconds(), double(s.replay_rows), double(s.rank0_rows)});
     spdlog::info("  q_ab: {}/{} attempts, epsilon {:.2f}, pi_b succeeded in {:.0f}%, switch at step {:.1f}",
                  trainer.attempts_done(), cfg.attempts, s.epsilon, 100 * s.success_rate, s.switch_step);
     trainer.save(ckpt);
-    int sig = signal_of(stop);
+    const int sig = group.any(signal_of(stop) != 0) ? std::max(signal_of(stop), 1) : 0;
     if (sig && trainer.attempts_done() < cfg.attempts) return sig;
+  }
+  if (!group.leader()) {
+    group.leader_done("the switch's margin");
+    return 0;
   }
   double margin = 0.0;
   if (cfg.validation_starts > 0) {
@@ -237,6 +288,7 @@ int train_switch(const CompositeRecipe& r, int t, const std::string& run, const 
   fs::remove(ckpt);
   spdlog::info("  q_ab: {} attempts, {} environment steps in {}", cfg.attempts, trainer.env_steps(),
                format_duration(trainer.wall_seconds()));
+  group.leader_done("the switch's margin");
   return 0;
 }
 
@@ -284,7 +336,9 @@ void write_actions(const CompositeRecipe& r, int t, const std::string& dir, int 
 
 int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
   const std::string run = recipe.pipeline.run_dir;
-  RunDir dir(run, recipe.resolved, recipe.defaulted);
+  const Distributed& group = *o.group;
+  if (group.leader()) RunDir(run, recipe.resolved, recipe.defaulted);
+  group.leader_done("the run directory");
   const int n = int(recipe.meta.transitions().size());
   const bool lee = recipe.pipeline.lee.enabled;
   const int stages = (lee ? 4 : 3) * n + 1;
@@ -292,7 +346,7 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
   auto announce = [&](const std::string& what) { spdlog::info("[stage {}/{}] {}", ++stage, stages, what); };
   // Runs a training stage unless its output exists; the signal number if it was stopped.
   auto stage_unless_done = [&](const std::string& output, const std::function<int()>& train) {
-    if (exists(output)) {
+    if (group.any(group.leader() && exists(output))) {
       spdlog::info("  done already: {}", output);
       return 0;
     }
@@ -304,9 +358,10 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
   // Every pi_ab first: S_a of a later transition is collected With TP through the earlier
   // ones, and switch training may carry episodes on through any of them (lookahead).
   for (int t = 0; t < n; ++t) {
-    fs::create_directories(tdir(t));
+    if (group.leader()) fs::create_directories(tdir(t));
+    group.leader_done("the transition's folder");
     announce(recipe.transition_name(t) + ": collect S_a and T_b");
-    if (int stop = collect(recipe, t, run, tdir(t), o.stop)) {
+    if (int stop = collect(recipe, t, run, tdir(t), o.stop, group)) {
       spdlog::warn("interrupted: rerun the same command to resume (this collection starts over)");
       return stop;
     }
@@ -316,7 +371,8 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
   }
   for (int t = 0; t < n; ++t) {
     announce(recipe.transition_name(t) + ": switch Q-network (double DQN, Algorithm 2)");
-    if (int stop = stage_unless_done(tdir(t) + "/q.pt", [&] { return train_switch(recipe, t, run, tdir(t), o.stop); }))
+    if (int stop = stage_unless_done(tdir(t) + "/q.pt",
+                                     [&] { return train_switch(recipe, t, run, tdir(t), o.stop, group); }))
       return stop;
   }
   for (int t = 0; t < n && lee; ++t) {
@@ -324,6 +380,7 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
     if (int stop = stage_unless_done(tdir(t) + "/lee.pt", [&] { return train_lee(recipe, t, tdir(t), o); }))
       return stop;
   }
+  if (!group.leader()) return 0;  // rank 0 evaluates
   announce("evaluate every method");
   for (int t = 0; t < n; ++t)
     if (!exists(tdir(t) + "/actions.csv")) write_actions(recipe, t, tdir(t));

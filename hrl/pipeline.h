@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "core/distributed.h"
 #include "hrl/composite_recipe.h"
 
 namespace segue {
@@ -27,6 +28,11 @@ struct PipelineOptions {
   const std::atomic<int>* stop = nullptr;  // set by a signal: checkpoint and return
   std::string publish_dir;             // also write the table here ("" = only the run dir)
   std::string command;                 // how the run was started, for the table
+  // Several ranks (segue run --nproc N): the PPO stages (pi_ab with its D, Lee's policy)
+  // are data-parallel, collection and the switch's attempts are split between the ranks;
+  // rank 0 writes the run directory, which every rank must see (one host, or a shared
+  // filesystem), and evaluates alone.
+  const Distributed* group = &Distributed::alone();
 };
 
 // Returns 0 when every stage is done, or the signal number when stopped early.

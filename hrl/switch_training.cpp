@@ -3,10 +3,12 @@
 #include <ATen/CPUGeneratorImpl.h>
 
 #include <algorithm>
+#include <cstring>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <sstream>
 
 #include "core/run_dir.h"
 
@@ -30,10 +32,10 @@ bool run_subtask(Env& env, TransitionController& after, int to, float* obs, int 
 
 SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& recipe, int transition,
                              StartStates starts, Policy pi_ab, std::vector<TransitionArtefacts> trained,
-                             uint64_t seed)
+                             uint64_t seed, const Distributed& group)
     : cfg_(config), recipe_(recipe), tr_(recipe.meta.transitions().at(transition)), starts_(std::move(starts)),
       pi_ab_(std::move(pi_ab)), env_(recipe.make_env()),
-      after_(recipe.skills, recipe.meta, std::move(trained), SwitchRule::IntervalEnd) {
+      after_(recipe.skills, recipe.meta, std::move(trained), SwitchRule::IntervalEnd), group_(group) {
   if (starts_.size() == 0) throw Error("switch training: S_a is empty");
   train_starts_ = starts_.size() - cfg_.validation_starts;
   if (train_starts_ < 1)
@@ -85,6 +87,7 @@ SwitchTrainer::SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& 
   }
   const float inf = std::numeric_limits<float>::infinity();
   q_ab_ = Policy(mean_network(), mean, inv_std, 5.0f, {-inf, -inf}, {inf, inf}, cfg_.features);
+  if (!group_.single()) rng_.seed(mix_seed(seed, 0x5317 + uint64_t(group_.rank())));  // each rank its attempts
 }
 
 EigenMlp SwitchTrainer::mean_network() const {
@@ -127,16 +130,90 @@ int SwitchTrainer::greedy(const float* in) {
 }
 
 void SwitchTrainer::store(const float* s, int a, double r, const float* s2, bool done) {
+  const size_t I = size_t(q_ab_.in_dim());
+  // Normalised with q_ab's input statistics, fixed from the probe on (the same on every rank).
+  pending_obs_.resize(pending_obs_.size() + I), pending_next_.resize(pending_next_.size() + I);
+  q_ab_.normalize(s, 1, &pending_obs_[pending_obs_.size() - I]);
+  q_ab_.normalize(s2, 1, &pending_next_[pending_next_.size() - I]);
+  if (group_.single()) {
+    push(&pending_obs_[0], a, float(r), &pending_next_[0], done ? 1.0f : 0.0f);
+    pending_obs_.clear(), pending_next_.clear();
+    ++rank0_rows_;
+    return;
+  }
+  pending_action_.push_back(a), pending_reward_.push_back(float(r)), pending_done_.push_back(done ? 1.0f : 0.0f);
+}
+
+void SwitchTrainer::push(const float* s, int64_t a, float r, const float* s2, float done) {
   const int I = q_ab_.in_dim();
   const int64_t cap = cfg_.replay, row = stored_ % cap;
   if (stored_ < cap) {
     obs_.resize(size_t(row + 1) * I), next_obs_.resize(size_t(row + 1) * I);
     action_.push_back(0), reward_.push_back(0), done_.push_back(0);
   }
-  q_ab_.normalize(s, 1, &obs_[row * I]);
-  q_ab_.normalize(s2, 1, &next_obs_[row * I]);
-  action_[row] = a, reward_[row] = float(r), done_[row] = done ? 1.0f : 0.0f;
+  std::copy(s, s + I, &obs_[row * I]);
+  std::copy(s2, s2 + I, &next_obs_[row * I]);
+  action_[row] = a, reward_[row] = r, done_[row] = done;
   ++stored_;
+}
+
+namespace {
+template <class T>
+void put(std::string& out, const std::vector<T>& v) {
+  const int64_t n = int64_t(v.size());
+  out.append(reinterpret_cast<const char*>(&n), sizeof n);
+  out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+}
+template <class T>
+std::vector<T> take(const std::string& in, size_t& at) {
+  int64_t n = 0;
+  std::memcpy(&n, in.data() + at, sizeof n);
+  at += sizeof n;
+  std::vector<T> v(static_cast<size_t>(n));
+  std::memcpy(v.data(), in.data() + at, v.size() * sizeof(T));
+  at += v.size() * sizeof(T);
+  return v;
+}
+}  // namespace
+
+void SwitchTrainer::run_round(int round, SwitchStats& s, int& updates) {
+  const int rank = group_.rank(), I = q_ab_.in_dim();
+  const int64_t steps_before = env_steps_;
+  std::vector<double> outcome{0, 0, 0};  // attempted, success, switch step
+  const double frac = std::min(1.0, (attempts_ + rank) / (cfg_.explore_fraction * std::max(cfg_.attempts, 1)));
+  const double eps = cfg_.epsilon_start + frac * (cfg_.epsilon_end - cfg_.epsilon_start);
+  if (rank < round) {
+    Outcome o = attempt(rng_.uniform(0.0, 1.0) < eps);
+    outcome = {1, double(o.success), double(o.switch_step)};
+  }
+  outcome.push_back(double(env_steps_ - steps_before));
+  std::string mine;
+  put(mine, outcome), put(mine, pending_obs_), put(mine, pending_next_), put(mine, pending_action_);
+  put(mine, pending_reward_), put(mine, pending_done_);
+  pending_obs_.clear(), pending_next_.clear(), pending_action_.clear(), pending_reward_.clear(), pending_done_.clear();
+  env_steps_ = steps_before;
+  // Every rank's transitions, in rank order, into every rank's buffer.
+  const std::vector<std::string> all = group_.gather(mine);
+  for (int r = 0; r < int(all.size()); ++r) {
+    size_t at = 0;
+    const auto o = take<double>(all[r], at);
+    const auto obs = take<float>(all[r], at), next = take<float>(all[r], at);
+    const auto action = take<int64_t>(all[r], at);
+    const auto reward = take<float>(all[r], at), done = take<float>(all[r], at);
+    for (size_t k = 0; k < action.size(); ++k)
+      push(&obs[k * I], action[k], reward[k], &next[k * I], done[k]);
+    if (r == 0) rank0_rows_ += int64_t(action.size());
+    env_steps_ += int64_t(o[3]);
+    if (o[0] > 0) s.attempts++, s.success_rate += o[1], s.switch_step += o[2];
+  }
+  s.epsilon = cfg_.epsilon_start +
+              std::min(1.0, (attempts_ + round - 1) / (cfg_.explore_fraction * std::max(cfg_.attempts, 1))) *
+                  (cfg_.epsilon_end - cfg_.epsilon_start);
+  attempts_ += round;
+  if (stored_ >= cfg_.warmup) {
+    for (int u = 0; u < cfg_.updates_per_attempt * round; ++u, ++updates) s.loss += update();
+    q_ab_ = q_function();
+  }
 }
 
 SwitchTrainer::Outcome SwitchTrainer::attempt(bool random) {
@@ -202,7 +279,8 @@ SwitchStats SwitchTrainer::run(int n) {
   const auto t0 = std::chrono::steady_clock::now();
   SwitchStats s;
   int updates = 0;
-  for (int k = 0; k < n; ++k) {
+  for (int k = 0; k < n && !group_.single(); k += group_.size()) run_round(std::min(group_.size(), n - k), s, updates);
+  for (int k = 0; k < n && group_.single(); ++k) {
     double frac = std::min(1.0, attempts_ / (cfg_.explore_fraction * std::max(cfg_.attempts, 1)));
     double eps = cfg_.epsilon_start + frac * (cfg_.epsilon_end - cfg_.epsilon_start);
     Outcome o = attempt(rng_.uniform(0.0, 1.0) < eps);
@@ -218,6 +296,7 @@ SwitchStats SwitchTrainer::run(int n) {
   }
   if (s.attempts) s.success_rate /= s.attempts, s.switch_step /= s.attempts;
   if (updates) s.loss /= updates;
+  s.replay_rows = stored_, s.rank0_rows = rank0_rows_;
   wall_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return s;
 }
@@ -244,13 +323,17 @@ void SwitchTrainer::save(const std::string& path) const {
   ar.write("replay_reward", blob(reward_, {rows}, torch::kFloat32));
   ar.write("replay_done", blob(done_, {rows}, torch::kFloat32));
   ar.write("counters", torch::tensor(std::vector<int64_t>{stored_, attempts_, updates_, env_steps_,
-                                                          int64_t(wall_seconds_ * 1000)}));
-  ar.write("rng", text_tensor(rng_.state()));
+                                                          int64_t(wall_seconds_ * 1000), rank0_rows_}));
+  // Every rank's attempt stream, one line each (the rest is the same on every rank).
+  std::string rngs;
+  for (const std::string& r : group_.gather(rng_.state())) rngs += (rngs.empty() ? "" : "\n") + r;
+  ar.write("rng", text_tensor(rngs));
   at::Generator gen = at::detail::getDefaultCPUGenerator();
   {
     std::lock_guard<std::mutex> lock(gen.mutex());
     ar.write("torch_rng", gen.get_state());
   }
+  if (!group_.leader()) return;
   std::ostringstream bytes;
   ar.save_to(bytes);
   write_file_atomic(path, bytes.str());
@@ -292,7 +375,12 @@ void SwitchTrainer::load(const std::string& path) {
   updates_ = int(counters[2].item<int64_t>());
   env_steps_ = counters[3].item<int64_t>();
   wall_seconds_ = counters[4].item<int64_t>() / 1000.0;
-  rng_.set_state(to_text(rng));
+  rank0_rows_ = counters.numel() > 5 ? counters[5].item<int64_t>() : stored_;
+  std::istringstream text(to_text(rng));
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(text, line);) lines.push_back(line);
+  if (size_t(group_.rank()) < lines.size()) rng_.set_state(lines[group_.rank()]);
+  else rng_.seed(mix_seed(uint64_t(attempts_), 0x5317 + uint64_t(group_.rank())));  // saved by fewer ranks
   at::Generator gen = at::detail::getDefaultCPUGenerator();
   {
     std::lock_guard<std::mutex> lock(gen.mutex());

@@ -47,14 +47,21 @@ struct SwitchStats {
   double success_rate = 0;   // of pi_b's subtask, over the attempts in this report
   double switch_step = 0;    // mean step of the interval where control was handed over
   double epsilon = 0, loss = 0;
+  int64_t replay_rows = 0;   // transitions stored so far, every rank's
+  int64_t rank0_rows = 0;    // of those, from rank 0's own attempts
 };
 
 class SwitchTrainer {
  public:
   // `trained`: the recipe's transition policies (by transition; missing ones are taken
   // as Without TP), which carry the episode on after pi_b when config.lookahead > 1.
+  // With `group` of W ranks, attempts go in rounds of W, one per rank (each rank its own
+  // random stream); every rank's transitions are then stored, in rank order, in every
+  // rank's replay buffer, and all ranks make the round's updates alike, so q_ab stays
+  // the same on every rank. save() is then a collective, rank 0 writing.
   SwitchTrainer(const SwitchConfig& config, const CompositeRecipe& recipe, int transition, StartStates starts,
-                Policy transition_policy, std::vector<TransitionArtefacts> trained, uint64_t seed);
+                Policy transition_policy, std::vector<TransitionArtefacts> trained, uint64_t seed,
+                const Distributed& group = Distributed::alone());
   // Runs `n` attempts (with their updates) and reports on them.
   SwitchStats run(int n);
   int attempts_done() const { return attempts_; }
@@ -87,6 +94,10 @@ class SwitchTrainer {
   };
   Outcome attempt(bool random);
   void store(const float* s, int a, double r, const float* s2, bool done);
+  // Appends a normalised transition to the replay ring.
+  void push(const float* s, int64_t a, float r, const float* s2, float done);
+  // A round of attempts on several ranks (run()'s body there).
+  void run_round(int round, SwitchStats& s, int& updates);
   double update();
   int greedy(const float* in);
   // switch_input() at the env's current state, whose features must be current in features_.
@@ -116,7 +127,12 @@ class SwitchTrainer {
   int64_t stored_ = 0;
   int attempts_ = 0, updates_ = 0, interval_length_ = 1;
   int train_starts_ = 0;  // S_a's first train_starts_ states train; the rest are held out
-  int64_t env_steps_ = 0;
+  int64_t env_steps_ = 0, rank0_rows_ = 0;
+  const Distributed& group_;
+  // This rank's transitions of the round in flight, normalised: obs, next obs, then per
+  // row action, reward, done.
+  std::vector<float> pending_obs_, pending_next_, pending_reward_, pending_done_;
+  std::vector<int64_t> pending_action_;
   double wall_seconds_ = 0;
   std::vector<float> full_, next_full_, qvals_, in_, next_in_;
   std::vector<double> features_, state_;

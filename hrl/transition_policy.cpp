@@ -13,8 +13,9 @@ torch::Tensor rows(const std::vector<float>& v, int64_t n) {
 }  // namespace
 
 TransitionPolicyTrainer::TransitionPolicyTrainer(const TransitionPolicyConfig& config, VectorEnv& envs,
-                                                 Demonstrations expert, const Policy& next, uint64_t seed)
-    : cfg_(config), ppo_(config.ppo, config.network(envs.spec(), next), envs, seed), expert_(std::move(expert)),
+                                                 Demonstrations expert, const Policy& next, uint64_t seed,
+                                                 const Distributed& group)
+    : cfg_(config), ppo_(config.ppo, config.network(envs.spec(), next), envs, seed, group), expert_(std::move(expert)),
       act_low_(envs.spec().act_low), act_high_(envs.spec().act_high) {
   const EnvSpec& spec = envs.spec();
   if (expert_.obs_dim != spec.obs_dim || expert_.act_dim != spec.act_dim)
@@ -55,10 +56,15 @@ void TransitionPolicyTrainer::discriminate(RolloutBuffer& buf) {
   for (int k : buf.truncated_index) done[k] = 0.0f;
 
   last_ = TransitionIterationStats();
-  const int64_t E = expert_obs_.size(0), B = cfg_.disc_batch;
+  const Distributed& group = ppo_.group();
+  const int64_t E = expert_obs_.size(0), B = cfg_.disc_batch, W = group.size();
+  double stats[4] = {0, 0, 0, 0};  // D's cross-entropy, expert and generator accuracy, over the ranks
   for (int step = 0; step < cfg_.disc_steps; ++step) {
+    // The same draws on every rank (LibTorch's stream is seeded alike): generator rows
+    // index this rank's rollout, expert rows take this rank's slice of W batches.
     auto gi = torch::randint(M, {std::min(B, M)}, torch::kLong);
-    auto ei = torch::randint(E, {std::min(B, E)}, torch::kLong);
+    auto ei = torch::randint(E, {W * std::min(B, E)}, torch::kLong).slice(0, group.rank() * std::min(B, E),
+                                                                           (group.rank() + 1) * std::min(B, E));
     auto eo = expert_obs_.index_select(0, ei), ea = expert_act_.index_select(0, ei);
     auto en = expert_next_.index_select(0, ei), ed = expert_done_.index_select(0, ei);
     auto e_logpi = ppo_.log_prob(eo.data_ptr<float>(), ea.data_ptr<float>(), eo.size(0));
@@ -69,21 +75,29 @@ void TransitionPolicyTrainer::discriminate(RolloutBuffer& buf) {
     auto loss = bce;
     if (cfg_.gradient_penalty > 0) loss = bce + cfg_.gradient_penalty * disc_->gradient_penalty(eo, ea, en, ed);
     disc_opt_->zero_grad();
-    loss.backward();
-    disc_opt_->step();
-    double l = loss.item<double>();
+    (loss / double(W)).backward();
+    const double l = group.sum_gradients(disc_->parameters(), loss.item<double>() / W);  // the mean over ranks
     if (!std::isfinite(l)) throw Error("discriminator loss became " + std::to_string(l));
-    last_.disc_loss += bce.item<double>() / cfg_.disc_steps;  // the logged loss is D's cross-entropy alone
-    last_.expert_accuracy += (e_logit > 0).to(torch::kFloat32).mean().item<double>() / cfg_.disc_steps;
-    last_.generator_accuracy += (g_logit < 0).to(torch::kFloat32).mean().item<double>() / cfg_.disc_steps;
+    disc_opt_->step();
+    stats[0] += bce.item<double>();  // the logged loss is D's cross-entropy alone
+    stats[1] += (e_logit > 0).to(torch::kFloat32).mean().item<double>();
+    stats[2] += (g_logit < 0).to(torch::kFloat32).mean().item<double>();
   }
+  group.sum(stats, 3);
+  last_.disc_loss = stats[0] / (W * cfg_.disc_steps);
+  last_.expert_accuracy = stats[1] / (W * cfg_.disc_steps);
+  last_.generator_accuracy = stats[2] / (W * cfg_.disc_steps);
   auto r = disc_->reward(obs, act, next, done, log_pi);  // Eq. 3
   if (cfg_.reward == "airl_nonnegative") r = torch::nn::functional::softplus(r);  // -log(1 - D)
   if (cfg_.reward == "airl_absorbing") {
-    const double gamma = cfg_.ppo.gamma, worst = r.min().item<double>();
+    auto lowest = r.min().reshape({1}).to(torch::kFloat64);
+    group.min(lowest);  // the worst reward over every rank's rows
+    const double gamma = cfg_.ppo.gamma, worst = lowest.item<double>();
     r = r + done * (gamma * std::min(worst, 0.0) / (1.0 - gamma));
   }
-  last_.airl_reward = r.mean().item<double>();
+  double mean_reward[2] = {r.sum().item<double>(), double(M)};
+  group.sum(mean_reward, 2);
+  last_.airl_reward = mean_reward[0] / mean_reward[1];
   auto rc = r.to(torch::kFloat64).contiguous();
   std::copy(rc.data_ptr<double>(), rc.data_ptr<double>() + M, buf.raw_rewards.begin());
 }

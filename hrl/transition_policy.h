@@ -25,9 +25,11 @@ struct TransitionIterationStats {
 class TransitionPolicyTrainer {
  public:
   // `envs` are TransitionEnvs; `expert` is T_b in pi_b's observation slice; `next` is pi_b
-  // (used to initialise pi_ab when config.init_from_next).
+  // (used to initialise pi_ab when config.init_from_next). With `group`, PPO is
+  // data-parallel (ppo.h) and D learns from every rank's generator rows: each rank draws
+  // its own minibatch of generator and expert rows, and D's gradients are averaged.
   TransitionPolicyTrainer(const TransitionPolicyConfig& config, VectorEnv& envs, Demonstrations expert,
-                          const Policy& next, uint64_t seed);
+                          const Policy& next, uint64_t seed, const Distributed& group = Distributed::alone());
 
   TransitionIterationStats iterate();
   Policy policy() const { return ppo_.policy(); }

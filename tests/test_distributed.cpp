@@ -17,8 +17,10 @@
 #include <thread>
 
 #include "core/distributed.h"
+#include "hrl/collection.h"
 #include "tests/cli_run.h"
 #include "tests/temp_dir.h"
+#include "tests/tiny_patrol.h"
 
 namespace segue {
 namespace {
@@ -112,10 +114,14 @@ class DataParallel : public TempDirTest {
                            "eval: {episodes: 1}\n";
     return file;
   }
-  std::string train(const std::string& file, const std::string& flags = "") {
-    CliRun r = run_cli("train " + file + " " + flags);
+  // Runs `segue ARGS`, expecting success; returns what it printed.
+  std::string segue_ok(const std::string& args) {
+    CliRun r = run_cli(args);
     EXPECT_EQ(r.code, 0) << r.output;
     return r.output;
+  }
+  std::string train(const std::string& file, const std::string& flags = "") {
+    return segue_ok("train " + file + " " + flags);
   }
 };
 
@@ -216,7 +222,7 @@ TEST_F(DataParallel, BadLaunchesAreRefusedInOneLine) {
   const std::vector<Case> cases{
       {"train " + file + " --nproc 0", "--nproc must be an integer in [1, 256], got '0'"},
       {"train " + file + " --nproc", "flag --nproc needs a value"},
-      {"run " + file + " --nproc 2", "--nproc is for 'segue train'"},
+      {"eval " + file + " --nproc 2", "--nproc is for 'segue train' and 'segue run'"},
       {own("MASTER_PORT=" + taken + " " + bin + " train " + file + " --nproc 2"),
        "MASTER_PORT " + taken + " (in use? pick another MASTER_PORT)"},
       {own("RANK=1 " + bin + " train " + file), "RANK is set but WORLD_SIZE is not"},
@@ -235,6 +241,35 @@ TEST_F(DataParallel, BadLaunchesAreRefusedInOneLine) {
   }
   EXPECT_FALSE(std::filesystem::exists(path("bad") + "/eval.json"));  // nothing trained
   ::close(fd);
+}
+
+// segue run on two ranks: collection split and joined, pi_ab and Lee's policy
+// data-parallel, the switch's attempts split, and every rank's attempts in the replay
+// buffer.
+TEST_F(DataParallel, TheMethodRunsOnTwoRanks) {
+  const std::string file = path("tiny_patrol.yaml");
+  std::ofstream(file) << kTinyPatrol << "lee: {enabled: true}\nrun_dir: " << path("patrol") << "\n";
+  segue_ok("run " + file + " --nproc 2");
+  const std::string t = path("patrol") + "/forward-balance/";
+  EXPECT_EQ(load_start_states(t + "start_states.pt").size(), 12);       // collect.start_states, both ranks' halves
+  EXPECT_EQ(load_demonstrations(t + "demonstrations.pt").size(), 400);  // collect.demonstrations
+  for (const auto& entry : std::filesystem::directory_iterator(t))
+    EXPECT_EQ(entry.path().string().find(".part"), std::string::npos) << entry.path();
+  EXPECT_EQ(csv(t + "transition.csv").size(), 1u + 2048 / 512);
+  EXPECT_EQ(csv(t + "lee.csv").size(), 1u + 2048 / 512);
+  for (const char* f : {"policy.pt", "q.pt", "lee.pt"}) EXPECT_TRUE(std::filesystem::exists(t + f)) << f;
+  EXPECT_TRUE(std::filesystem::exists(path("patrol") + "/patrol.json"));
+  const auto sw = csv(t + "switch.csv");
+  ASSERT_GE(sw.size(), 2u);
+  auto column = [&](const std::string& name) {
+    const size_t c = size_t(std::find(sw[0].begin(), sw[0].end(), name) - sw[0].begin());
+    return std::stod(sw.back().at(c));
+  };
+  EXPECT_EQ(column("attempts"), 24);
+  // Rank 1's transitions are in rank 0's buffer: rank 0's own are only part of it.
+  EXPECT_GT(column("rank0_rows"), 0);
+  EXPECT_GT(column("replay_rows"), column("rank0_rows"));
+  EXPECT_GE(column("replay_rows"), 24);  // at least one transition per attempt
 }
 
 }  // namespace

@@ -6,7 +6,11 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <filesystem>
+#include <fstream>
 #include <regex>
+#include <sstream>
+#include <unistd.h>
 
 #include "algorithms/skill_recipe.h"
 #include "core/assets.h"
@@ -27,8 +31,9 @@ const Command kBench{
     "bare mj_step on the same trajectories: the rollout's controls (and pushes) are\n"
     "recorded and replayed through mj_step alone. Reported: rollout with policy inference,\n"
     "the full PPO loop (rollout and update), and the bare replay, on one thread and on every\n"
-    "core, with each robot's skill recipe (walker_forward, jaco_pick); and mujoco-testspeed\n"
-    "on the walker's XML for reference.",
+    "core, with each robot's skill recipe (walker_forward, jaco_pick); data-parallel PPO\n"
+    "on 1 and 2 ranks (segue train --nproc, one thread each) with the time spent in\n"
+    "collectives; and mujoco-testspeed on the walker's XML for reference.",
     {},
     {{"json", "", "print one JSON object"},
      {"iterations", "K", "PPO iterations per measurement (default 5)"},
@@ -190,6 +195,52 @@ Rates rates(const SkillRecipe& s, int threads, int iterations) {
   return {rollout, full, bare};
 }
 
+// Full PPO on `ranks` local ranks (segue train --nproc, one thread each), read back from
+// the run's metrics.csv: physics steps per second over the iterations after the first
+// (env steps x frame_skip, resets aside), and the seconds per iteration spent in
+// collectives with the other ranks.
+struct RankRates {
+  double ppo_sps = NAN, comm_seconds = NAN;
+};
+
+RankRates ppo_on_ranks(const std::string& recipe, const SkillRecipe& s, int ranks, int iterations) {
+  const std::string dir = (std::filesystem::temp_directory_path() /
+                           ("segue_bench_ranks_" + std::to_string(::getpid()) + "_" + std::to_string(ranks))).string();
+  std::filesystem::remove_all(dir);
+  const int64_t steps = int64_t(iterations + 1) * s.ppo.rollout_size();
+  const std::string cmd = "/proc/self/exe train '" + recipe + "' --nproc " + std::to_string(ranks) +
+                          " --set run_dir=" + dir + " --set threads=1 --set eval.episodes=1 --set ppo.total_steps=" +
+                          std::to_string(steps) + " >/dev/null 2>&1";
+  if (std::system(cmd.c_str()) != 0)
+    throw Error("segue bench: the " + std::to_string(ranks) + "-rank PPO run failed: " + cmd);
+  std::ifstream in(dir + "/metrics.csv");
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  std::stringstream hs(line);
+  for (std::string c; std::getline(hs, c, ',');) header.push_back(c);
+  auto column = [&](const std::string& name) {
+    return size_t(std::find(header.begin(), header.end(), name) - header.begin());
+  };
+  const size_t rollout = column("rollout_seconds"), update = column("update_seconds"), comm = column("comm_seconds");
+  double seconds = 0, comm_total = 0;
+  int rows = 0;
+  for (int r = 0; std::getline(in, line); ++r) {
+    std::vector<std::string> cells;
+    std::stringstream ls(line);
+    for (std::string c; std::getline(ls, c, ',');) cells.push_back(c);
+    if (r == 0 || cells.size() < header.size()) continue;  // the first iteration warms up
+    seconds += std::stod(cells[rollout]) + std::stod(cells[update]);
+    comm_total += std::stod(cells[comm]);
+    ++rows;
+  }
+  std::filesystem::remove_all(dir);
+  auto probe = s.make_env();
+  const int frame_skip = dynamic_cast<const MujocoEnv&>(*probe).frame_skip();
+  if (rows == 0) throw Error("segue bench: the " + std::to_string(ranks) + "-rank PPO run wrote no metrics");
+  return {double(rows) * s.ppo.rollout_size() * frame_skip / seconds, comm_total / rows};
+}
+
 }  // namespace
 
 int bench_main(int argc, char** argv) {
@@ -229,7 +280,30 @@ int bench_main(int argc, char** argv) {
     std::printf("  full PPO loop, %d cores          %10.0f  %5.2f of bare, %5.2fx one thread\n", cores, all.ppo,
                 all.ppo / all.bare, all.ppo / one.ppo);
   }
-  if (args.has("json")) std::printf("%s\n", json_object(json).c_str());
+  // Data parallelism: the walker's PPO on 1 and 2 ranks of one thread each.
+  const std::string path = std::string(SEGUE_SOURCE_DIR) + "/experiments/primitives/walker_forward.yaml";
+  Recipe recipe = Recipe::load(path);
+  const SkillRecipe s = SkillRecipe::read(recipe, "runs/bench");
+  const RankRates one = ppo_on_ranks(path, s, 1, iterations), two = ppo_on_ranks(path, s, 2, iterations);
+  const int64_t allreduces = s.ppo.epochs * ((s.ppo.rollout_size() + s.ppo.minibatch_size - 1) / s.ppo.minibatch_size);
+  int64_t floats = 0;
+  for (const auto& p : ActorCritic(s.net)->parameters()) floats += p.numel();
+  json.push_back({"ppo_ranks_comm_seconds_per_iteration", two.comm_seconds});
+  json.push_back({"ppo_ranks_allreduces_per_iteration", double(allreduces)});
+  json.push_back({"ppo_ranks_gradient_floats", double(floats)});
+  if (args.has("json")) {
+    std::string text = json_object(json);
+    text.insert(text.size() - 1, ", \"ppo_sps_by_ranks\": " +
+                                     json_object({{"1", one.ppo_sps}, {"2", two.ppo_sps}}));
+    std::printf("%s\n", text.c_str());
+    return 0;
+  }
+  std::printf("data-parallel PPO (walker_forward, segue train --nproc N, 1 thread per rank)\n");
+  std::printf("  1 rank                          %10.0f\n", one.ppo_sps);
+  std::printf("  2 ranks                         %10.0f  %5.2fx one rank  (target >= 1.7 on 2 cores)\n", two.ppo_sps,
+              two.ppo_sps / one.ppo_sps);
+  std::printf("  2 ranks: %.3f s per iteration in collectives (%lld gradient all-reduces of %lld floats)\n",
+              two.comm_seconds, (long long)allreduces, (long long)floats);
   return 0;
 }
 

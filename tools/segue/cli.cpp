@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <sstream>
 
+#include "core/distributed.h"
+#include "core/run_dir.h"
 #include "core/thread_pool.h"
 
 namespace segue::cli {
@@ -105,6 +107,16 @@ const std::atomic<int>& install_stop_signals() {
 void uninstall_stop_signals() {
   std::signal(SIGINT, SIG_DFL);
   std::signal(SIGTERM, SIG_DFL);
+}
+
+void require_same_recipe(const std::string& resolved, const std::string& file) {
+  const Distributed& group = Distributed::world();
+  if (group.single()) return;
+  const std::string diff = recipe_difference(group.broadcast(resolved), resolved, file);
+  const std::vector<std::string> all = group.gather(diff);
+  for (size_t r = 0; r < all.size(); ++r)
+    if (!all[r].empty())
+      throw Error(file + ": rank " + std::to_string(r) + " was started with another recipe than rank 0 (" + all[r] + ")");
 }
 
 void set_torch_threads(int threads) {

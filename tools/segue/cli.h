@@ -66,6 +66,10 @@ int run_plot_tool(const std::string& args);
 const std::atomic<int>& install_stop_signals();
 void uninstall_stop_signals();
 
+// With several ranks: every rank must run the same resolved recipe as rank 0; a
+// difference is refused on every rank, naming the first key that differs (`threads` may).
+void require_same_recipe(const std::string& resolved, const std::string& file);
+
 // Sets LibTorch's intra-op threads; 0 means every core.
 void set_torch_threads(int threads);
 

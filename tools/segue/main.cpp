@@ -76,15 +76,15 @@ int main(int argc, char** argv) {
   const std::string cmd = argv[1];
   std::string who;  // "rank R: " before an error, when there are several ranks
   try {
-    // `segue train ... --nproc N` starts N local ranks of itself; a rank finds RANK and
+    // `segue train|run ... --nproc N` starts N local ranks of itself; a rank finds RANK and
     // WORLD_SIZE in its environment (torchrun's conventions) and joins the others.
     std::vector<std::string> args(argv, argv + argc);
     const int nproc = take_nproc(args);
-    if (nproc > 0 && cmd != "train")
-      throw segue::Error("--nproc is for 'segue train' (skills and Single baselines); 'segue " + cmd +
-                         "' runs on one process");
+    const bool parallel = cmd == "train" || cmd == "run";
+    if (nproc > 0 && !parallel)
+      throw segue::Error("--nproc is for 'segue train' and 'segue run'; 'segue " + cmd + "' runs on one process");
     if (nproc > 1) return segue::launch_local_ranks(nproc, args);
-    if (cmd == "train") {
+    if (parallel) {
       segue::Distributed::init_from_environment();
       const auto& world = segue::Distributed::world();
       if (!world.single()) {

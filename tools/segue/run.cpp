@@ -3,6 +3,7 @@
 
 #include <cstdio>
 
+#include "core/distributed.h"
 #include "hrl/pipeline.h"
 #include "tools/segue/cli.h"
 
@@ -22,6 +23,7 @@ const Command kRun{
     {{"set", "key=value", "override a recipe key (repeatable), e.g. --set switch.attempts=500", true},
      {"threads", "N", "threads stepping environments (overrides the recipe; 0 = all cores)"},
      {"publish", "DIR", "also write TASK.md and TASK.json to DIR (e.g. experiments/results)"},
+     {"nproc", "N", "N local ranks: data-parallel pi_ab and Lee, split collection (docs/distributed.md)"},
      {"check", "", "read and check the recipe, then stop"}}};
 
 }  // namespace
@@ -33,8 +35,10 @@ int run_main(int argc, char** argv) {
   if (args.has("threads")) sets.push_back("threads=" + args.get("threads", "0"));
   CompositeRecipe recipe = CompositeRecipe::load(args.positional(0), sets);
   if (args.has("check")) return std::printf("%s: ok\n", args.positional(0).c_str()) < 0;
+  require_same_recipe(recipe.resolved, args.positional(0));
   set_torch_threads(1);  // as in training: results do not depend on the thread count
   PipelineOptions o;
+  o.group = &Distributed::world();
   o.threads = resolve_threads(recipe.pipeline.threads);
   o.stop = &install_stop_signals();
   o.publish_dir = args.get("publish", "");

@@ -155,21 +155,6 @@ SkillRecipe read_skill(const Recipe& recipe, const std::string& default_run_dir)
 int train_skill(const Recipe& recipe, const SkillRecipe& s);
 int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool check_only);
 
-// Every rank must train the same recipe as rank 0: a difference is refused on every rank,
-// naming the first key that differs (`threads` may differ).
-void require_same_recipe(const Recipe& recipe) {
-  const Distributed& group = Distributed::world();
-  if (group.single()) return;
-  const std::string mine = recipe.resolved_yaml(), leaders = group.broadcast(mine);
-  const std::string diff = recipe_difference(leaders, mine, recipe.file());
-  std::string report;
-  const std::vector<std::string> all = group.gather(diff);
-  for (size_t r = 0; r < all.size() && report.empty(); ++r)
-    if (!all[r].empty())
-      report = recipe.file() + ": rank " + std::to_string(r) + " was started with another recipe than rank 0 (" + all[r] + ")";
-  if (!report.empty()) throw Error(report);
-}
-
 }  // namespace
 
 int train_main(int argc, char** argv) {
@@ -332,7 +317,7 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
 int train_skill(const Recipe& recipe, const SkillRecipe& s) {
   const std::string recipe_path = recipe.file();
   const Distributed& group = Distributed::world();
-  require_same_recipe(recipe);  // read whole by now: every key with its value or default
+  require_same_recipe(recipe.resolved_yaml(), recipe.file());  // read whole by now: every key with its value or default
   const int threads = resolve_threads(s.threads);
   // LibTorch runs on one thread: the networks are too small to gain from more, and a
   // fixed thread count keeps floating-point sums, and so the trained policy, the same

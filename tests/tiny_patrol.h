@@ -1,0 +1,28 @@
+#pragma once
+// A composite recipe small enough for tests: Patrol cut to one transition (forward ->
+// balance), 300-step episodes, no pushes, budgets of a few seconds.
+namespace segue {
+
+inline constexpr const char* kTinyPatrol = R"(
+task: patrol
+env: {max_episode_steps: 300, push_prob: 0}
+skills:
+  forward: {policy: assets/policies/walker/walker_forward.pt}
+  backward: {policy: assets/policies/walker/walker_backward.pt}
+  balance: {policy: assets/policies/walker/walker_balance.pt}
+start:
+  - {skill: forward, when: {direction: 1}}
+  - {skill: backward, when: {direction: -1}}
+transitions:
+  - {from: forward, to: balance, when: {since_turn: [0, 100]}, expert: {when: {steps: [0, 100]}}}
+seed: 3
+threads: 1
+collect: {start_states: 12, demonstrations: 400}
+transition:
+  ppo: {total_steps: 2048, num_envs: 4, steps_per_env: 128, minibatch_size: 256, epochs: 2}
+  discriminator: {steps: 4, batch: 64}
+switch: {attempts: 24, warmup: 16, batch: 16, updates_per_attempt: 2}
+eval: {episodes: 3, seeds: [0]}
+)";
+
+}  // namespace segue
