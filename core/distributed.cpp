@@ -127,7 +127,7 @@ void Distributed::run(const char* op, const std::function<void()>& body) const {
   try {
     body();
   } catch (const std::exception& e) {
-    throw Error("rank " + std::to_string(rank_) + " lost the other ranks in " + op +
+    throw Error(std::string("lost the other ranks in ") + op +
                 " (one stopped, or hung past SEGUE_DIST_TIMEOUT=" + std::to_string(int(timeout_s_)) +
                 " s): " + first_line(e.what()) + "; rerun the same command to resume from the last checkpoint");
   }
@@ -272,6 +272,12 @@ int launch_local_ranks(int nproc, const std::vector<std::string>& argv) {
   if (nproc < 1 || nproc > 256) throw Error("--nproc must be in [1, 256], got " + std::to_string(nproc));
   if (std::getenv("RANK") || std::getenv("WORLD_SIZE"))
     throw Error("--nproc starts its own ranks: unset RANK and WORLD_SIZE, or drop --nproc");
+  // With NNODES and NODE_RANK (torchrun's multi-node form), this host's ranks are
+  // NODE_RANK * nproc + 0..nproc-1 of NNODES * nproc, meeting at MASTER_ADDR:MASTER_PORT.
+  const int nodes = std::getenv("NNODES") ? env_int("NNODES", 1, 4096) : 1;
+  const int node = nodes > 1 ? env_int("NODE_RANK", 0, nodes - 1) : 0;
+  if (nodes > 1 && (!std::getenv("MASTER_ADDR") || !std::getenv("MASTER_PORT")))
+    throw Error("NNODES is " + std::to_string(nodes) + ": set MASTER_ADDR and MASTER_PORT to rank 0's host and port");
   const std::string port = std::getenv("MASTER_PORT") ? std::to_string(env_int("MASTER_PORT", 1, 65535))
                                                       : std::to_string(free_port());
   std::vector<char*> args;
@@ -286,8 +292,8 @@ int launch_local_ranks(int nproc, const std::vector<std::string>& argv) {
       // forwards it once); and a launcher that dies takes its ranks with it.
       ::setpgid(0, 0);
       ::prctl(PR_SET_PDEATHSIG, SIGTERM);
-      ::setenv("RANK", std::to_string(r).c_str(), 1);
-      ::setenv("WORLD_SIZE", std::to_string(nproc).c_str(), 1);
+      ::setenv("RANK", std::to_string(node * nproc + r).c_str(), 1);
+      ::setenv("WORLD_SIZE", std::to_string(nodes * nproc).c_str(), 1);
       ::setenv("LOCAL_RANK", std::to_string(r).c_str(), 1);
       ::setenv("LOCAL_WORLD_SIZE", std::to_string(nproc).c_str(), 1);
       ::setenv("MASTER_ADDR", env_or("MASTER_ADDR", "127.0.0.1").c_str(), 1);

@@ -77,8 +77,9 @@ class Distributed {
 
 // segue COMMAND ... --nproc N: starts N copies of the command on this host as ranks
 // 0..N-1 (RANK, WORLD_SIZE, MASTER_ADDR, MASTER_PORT set; a free port unless MASTER_PORT
-// is), forwards Ctrl-C and SIGTERM, and when a rank fails stops the others and returns
-// its exit status. `argv` is the command line without --nproc.
+// is), or with NNODES and NODE_RANK as ranks NODE_RANK * N + 0..N-1 of NNODES * N;
+// forwards Ctrl-C and SIGTERM, and when a rank fails stops the others and returns its
+// exit status. `argv` is the command line without --nproc.
 int launch_local_ranks(int nproc, const std::vector<std::string>& argv);
 
 }  // namespace segue

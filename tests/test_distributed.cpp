@@ -272,5 +272,37 @@ TEST_F(DataParallel, TheMethodRunsOnTwoRanks) {
   EXPECT_GE(column("replay_rows"), 24);  // at least one transition per attempt
 }
 
+// A rank that hangs (stopped, not dead: its connections stay open) makes rank 0's next
+// collective give up after SEGUE_DIST_TIMEOUT, and the launcher stops the rest.
+TEST_F(DataParallel, AHungRankStopsTheOthersWithinTheTimeout) {
+  const std::string file = recipe("hung", 400);
+  const std::string log = path("hung.log");
+  const pid_t launcher = fork();
+  if (launcher == 0) {
+    freopen(log.c_str(), "w", stderr);
+    freopen("/dev/null", "w", stdout);
+    setenv("SEGUE_DIST_TIMEOUT", "2", 1);
+    execl(SEGUE_BINARY, SEGUE_BINARY, "train", file.c_str(), "--nproc", "2", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (csv(path("hung") + "/metrics.csv").size() < 3 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const std::vector<pid_t> ranks = children(launcher);
+  ASSERT_EQ(ranks.size(), 2u);
+  ::kill(ranks[1], SIGSTOP);
+  const auto stopped = std::chrono::steady_clock::now();
+  int status = 0;
+  ::waitpid(launcher, &status, 0);
+  const double waited = std::chrono::duration<double>(std::chrono::steady_clock::now() - stopped).count();
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) != 0);
+  EXPECT_LT(waited, 30.0);  // the 2 s timeout, and the launcher's stop, not a hang
+  std::ifstream in(log);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("error: rank 0: lost the other ranks in"), std::string::npos) << text;
+  EXPECT_NE(text.find("SEGUE_DIST_TIMEOUT=2 s"), std::string::npos) << text;
+  EXPECT_NE(text.find("the other ranks were stopped"), std::string::npos) << text;
+}
+
 }  // namespace
 }  // namespace segue

@@ -203,14 +203,17 @@ struct RankRates {
   double ppo_sps = NAN, comm_seconds = NAN;
 };
 
-RankRates ppo_on_ranks(const std::string& recipe, const SkillRecipe& s, int ranks, int iterations) {
+RankRates ppo_on_ranks(const std::string& recipe, const SkillRecipe& s, int ranks, int iterations,
+                       int64_t minibatch) {
   const std::string dir = (std::filesystem::temp_directory_path() /
                            ("segue_bench_ranks_" + std::to_string(::getpid()) + "_" + std::to_string(ranks))).string();
   std::filesystem::remove_all(dir);
   const int64_t steps = int64_t(iterations + 1) * s.ppo.rollout_size();
-  const std::string cmd = "/proc/self/exe train '" + recipe + "' --nproc " + std::to_string(ranks) +
+  const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();  // this segue binary
+  const std::string cmd = "'" + self + "' train '" + recipe + "' --nproc " + std::to_string(ranks) +
                           " --set run_dir=" + dir + " --set threads=1 --set eval.episodes=1 --set ppo.total_steps=" +
-                          std::to_string(steps) + " >/dev/null 2>&1";
+                          std::to_string(steps) + " --set ppo.minibatch_size=" + std::to_string(minibatch) +
+                          " >/dev/null 2>&1";
   if (std::system(cmd.c_str()) != 0)
     throw Error("segue bench: the " + std::to_string(ranks) + "-rank PPO run failed: " + cmd);
   std::ifstream in(dir + "/metrics.csv");
@@ -280,30 +283,39 @@ int bench_main(int argc, char** argv) {
     std::printf("  full PPO loop, %d cores          %10.0f  %5.2f of bare, %5.2fx one thread\n", cores, all.ppo,
                 all.ppo / all.bare, all.ppo / one.ppo);
   }
-  // Data parallelism: the walker's PPO on 1 and 2 ranks of one thread each.
+  // Data parallelism: the walker's PPO on 1 and 2 ranks of one thread each, with the
+  // recipe's minibatches and with one minibatch per epoch (the update's exchanges and
+  // fixed per-minibatch costs then matter least).
   const std::string path = std::string(SEGUE_SOURCE_DIR) + "/experiments/primitives/walker_forward.yaml";
   Recipe recipe = Recipe::load(path);
   const SkillRecipe s = SkillRecipe::read(recipe, "runs/bench");
-  const RankRates one = ppo_on_ranks(path, s, 1, iterations), two = ppo_on_ranks(path, s, 2, iterations);
-  const int64_t allreduces = s.ppo.epochs * ((s.ppo.rollout_size() + s.ppo.minibatch_size - 1) / s.ppo.minibatch_size);
   int64_t floats = 0;
   for (const auto& p : ActorCritic(s.net)->parameters()) floats += p.numel();
-  json.push_back({"ppo_ranks_comm_seconds_per_iteration", two.comm_seconds});
-  json.push_back({"ppo_ranks_allreduces_per_iteration", double(allreduces)});
+  std::string by_ranks;
+  if (!args.has("json")) std::printf("data-parallel PPO (walker_forward, segue train --nproc N, 1 thread per rank)\n");
+  for (const int64_t minibatch : {int64_t(s.ppo.minibatch_size), s.ppo.rollout_size()}) {
+    const RankRates one = ppo_on_ranks(path, s, 1, iterations, minibatch);
+    const RankRates two = ppo_on_ranks(path, s, 2, iterations, minibatch);
+    const int64_t allreduces = s.ppo.epochs * ((s.ppo.rollout_size() + minibatch - 1) / minibatch);
+    const std::string suffix = minibatch == s.ppo.minibatch_size ? "" : "_one_minibatch";
+    by_ranks += ", \"ppo_sps_by_ranks" + suffix + "\": " + json_object({{"1", one.ppo_sps}, {"2", two.ppo_sps}});
+    json.push_back({"ppo_ranks" + suffix + "_comm_seconds_per_iteration", two.comm_seconds});
+    json.push_back({"ppo_ranks" + suffix + "_allreduces_per_iteration", double(allreduces)});
+    if (args.has("json")) continue;
+    std::printf("  minibatches of %lld (%lld gradient all-reduces of %lld floats per iteration)\n", (long long)minibatch,
+                (long long)allreduces, (long long)floats);
+    std::printf("    1 rank                        %10.0f\n", one.ppo_sps);
+    std::printf("    2 ranks                       %10.0f  %5.2fx one rank  (target >= 1.7 on 2 cores)\n", two.ppo_sps,
+                two.ppo_sps / one.ppo_sps);
+    std::printf("    2 ranks: %.3f s per iteration in collectives, %.2f ms per all-reduce\n", two.comm_seconds,
+                1e3 * two.comm_seconds / double(allreduces));
+  }
   json.push_back({"ppo_ranks_gradient_floats", double(floats)});
   if (args.has("json")) {
     std::string text = json_object(json);
-    text.insert(text.size() - 1, ", \"ppo_sps_by_ranks\": " +
-                                     json_object({{"1", one.ppo_sps}, {"2", two.ppo_sps}}));
+    text.insert(text.size() - 1, by_ranks);
     std::printf("%s\n", text.c_str());
-    return 0;
   }
-  std::printf("data-parallel PPO (walker_forward, segue train --nproc N, 1 thread per rank)\n");
-  std::printf("  1 rank                          %10.0f\n", one.ppo_sps);
-  std::printf("  2 ranks                         %10.0f  %5.2fx one rank  (target >= 1.7 on 2 cores)\n", two.ppo_sps,
-              two.ppo_sps / one.ppo_sps);
-  std::printf("  2 ranks: %.3f s per iteration in collectives (%lld gradient all-reduces of %lld floats)\n",
-              two.comm_seconds, (long long)allreduces, (long long)floats);
   return 0;
 }
 
