@@ -34,6 +34,21 @@ void LeeTransitionEnv::restore_state(const std::vector<double>& state, float* ob
   inner_.restore_state(state, obs);
 }
 
+bool LeeTransitionEnv::save_episode(std::vector<double>& state, std::string& rng) const {
+  if (!inner_.save_episode(state, rng)) return false;
+  state.insert(state.end(), current_.states.begin(), current_.states.end());
+  state.push_back(double(current_.states.size()));
+  return true;
+}
+
+void LeeTransitionEnv::restore_episode(const std::vector<double>& state, const std::string& rng, float* obs) {
+  const size_t n = state.empty() ? 0 : size_t(state.back());
+  if (state.empty() || n + 1 > state.size()) throw Error(spec_.name + ": a saved episode of another kind");
+  const auto states_begin = state.end() - 1 - long(n);
+  current_.states.assign(states_begin, state.end() - 1);
+  inner_.restore_episode(std::vector<double>(state.begin(), states_begin), rng, obs);
+}
+
 StepResult LeeTransitionEnv::step(const float* action, float* obs) {
   const int D = spec_.obs_dim;
   StepResult r;

@@ -30,6 +30,9 @@ class LeeTransitionEnv : public Env {
   void features(double* out) const override { inner_.features(out); }
   void save_state(std::vector<double>& out) const override { inner_.save_state(out); }
   void restore_state(const std::vector<double>& state, float* obs) override;
+  // The inner episode, then the states of this episode so far (P_b's labels need them).
+  bool save_episode(std::vector<double>& state, std::string& rng) const override;
+  void restore_episode(const std::vector<double>& state, const std::string& rng, float* obs) override;
 
   // Episodes finished since the last call: their states s_0..s_T (pi_b's slice) and outcome.
   struct Episode {

@@ -45,6 +45,22 @@ StepResult TransitionEnv::step(const float* action, float* obs) {
   return r;
 }
 
+bool TransitionEnv::save_episode(std::vector<double>& state, std::string& rng) const {
+  if (!task_->save_episode(state, rng)) return false;
+  state.push_back(double(steps_));
+  rng += "|" + rng_.state();  // one line per environment (VectorEnv::save_episodes)
+  return true;
+}
+
+void TransitionEnv::restore_episode(const std::vector<double>& state, const std::string& rng, float* obs) {
+  const size_t bar = rng.rfind('|');
+  if (state.empty() || bar == std::string::npos) throw Error(spec_.name + ": a saved episode of another kind");
+  task_->restore_episode(std::vector<double>(state.begin(), state.end() - 1), rng.substr(0, bar), full_.data());
+  steps_ = int(state.back());
+  rng_.set_state(rng.substr(bar + 1));
+  slice(obs);
+}
+
 void TransitionEnv::restore_state(const std::vector<double>& state, float* obs) {
   task_->restore_state(state, full_.data());
   steps_ = 0;

@@ -23,6 +23,10 @@ class TransitionEnv : public Env {
   void features(double* out) const override { task_->features(out); }
   void save_state(std::vector<double>& out) const override { task_->save_state(out); }
   void restore_state(const std::vector<double>& state, float* obs) override;
+  // The task's episode, then this wrapper's step count and start-drawing stream: a
+  // resumed transition stage goes on with the episodes in flight.
+  bool save_episode(std::vector<double>& state, std::string& rng) const override;
+  void restore_episode(const std::vector<double>& state, const std::string& rng, float* obs) override;
   Env& task() { return *task_; }
   // The task's whole observation after the last reset or step (pi_ab sees a slice of it).
   const std::vector<float>& task_obs() const { return full_; }

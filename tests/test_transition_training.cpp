@@ -742,4 +742,50 @@ TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
   }
 }
 
+// The transition stage and Lee's, stopped after every iteration and resumed, write the rows
+// and the policies of the unbroken run: their checkpoints carry the episodes in flight
+// (TransitionEnv and LeeTransitionEnv save theirs), not only the networks.
+TEST_F(TransitionTraining, StoppedPpoStagesResumeToTheUnbrokenRun) {
+  tiny();  // writes the recipe file
+  auto prepared = [&](const std::string& run) {
+    CompositeRecipe r = CompositeRecipe::load(path("tiny_patrol.yaml"), {"lee.enabled=true", "run_dir=" + path(run)});
+    const std::string t = path(run + "/forward-balance/");
+    fs::create_directories(t);
+    save(collect_start_states(r, 0, r.pipeline.collect.start_states, 1), t + "start_states.pt");
+    save(collect_demonstrations(r, 0, r.pipeline.collect.demonstrations, 2), t + "demonstrations.pt");
+    return r;
+  };
+  PipelineOptions o;
+  o.command = "test";
+  const CompositeRecipe unbroken = prepared("unbroken");
+  ASSERT_EQ(run_pipeline(unbroken, o), 0);
+  const CompositeRecipe stopped = prepared("stopped");
+  std::atomic<int> stop{15};
+  o.stop = &stop;
+  const std::string t = path("stopped/forward-balance/"), u = path("unbroken/forward-balance/");
+  for (int run = 0; run < 60 && !fs::exists(t + "lee.pt"); ++run) {
+    const int rc = run_pipeline(stopped, o);  // stopped, but for the run that finishes the last stage
+    EXPECT_TRUE(rc == 15 || fs::exists(t + "lee.pt")) << rc;
+  }
+  ASSERT_TRUE(fs::exists(t + "lee.pt"));
+  auto rows = [](const std::string& file) {
+    std::ifstream in(file);
+    std::vector<std::string> out;
+    for (std::string line; std::getline(in, line);) out.push_back(line.substr(0, line.rfind(',')));  // less wall_seconds
+    return out;
+  };
+  for (const char* csv : {"transition.csv", "lee.csv"}) {
+    ASSERT_EQ(rows(t + csv).size(), 1u + 2048 / 512) << csv;
+    EXPECT_EQ(rows(t + csv), rows(u + csv)) << csv;
+  }
+  const std::vector<float> obs = random_obs(8, unbroken.skills[2].policy.obs_dim(), 4);
+  for (const char* f : {"policy.pt", "lee.pt"}) {
+    Policy a = Policy::load(t + f), b = Policy::load(u + f);
+    std::vector<float> ya(8 * a.act_dim()), yb(8 * b.act_dim());
+    a.act(obs.data(), 8, ya.data());
+    b.act(obs.data(), 8, yb.data());
+    EXPECT_EQ(ya, yb) << f;
+  }
+}
+
 }  // namespace segue
