@@ -126,10 +126,12 @@ int train_es(const SkillRecipe& s, const Recipe& recipe, const std::string& reci
     const double grad = es.tell(fitness);
     env_steps += int64_t(steps);
     wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    es.save(dir.checkpoint(), recipe.resolved_yaml(), {env_steps, int64_t(wall * 1000)});
-    space.policy_at(es.theta()).export_torchscript(dir.file("policy.pt"));
+    // The row before the checkpoint: a kill between the two repeats the generation, and the
+    // resumed run drops the row past its checkpoint, so no row is lost or doubled.
     csv.write({double(es.generation()), double(env_steps), centre_success, centre_return, mean_success, best,
                mean_return, grad, wall});
+    es.save(dir.checkpoint(), recipe.resolved_yaml(), {env_steps, int64_t(wall * 1000)});
+    space.policy_at(es.theta()).export_torchscript(dir.file("policy.pt"));
     progress.update(es.generation(), centre_return, centre_success);
     if (stop && es.generation() < cfg.generations) {
       progress.finish();
