@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 
 namespace segue {
 
@@ -36,14 +37,22 @@ void Progress::update(long steps, double ret, double success) {
   char rate[48];
   if (sps >= 10) std::snprintf(rate, sizeof rate, "%.0f %ss/s", sps, unit_.c_str());
   else std::snprintf(rate, sizeof rate, "%.1f %ss/min", 60 * sps, unit_.c_str());
-  std::fprintf(stderr, "%s[%s] %s %ld/%ld (%.0f%%)  %s  return %.1f  success %.0f%%  ETA %s%s",
-               tty_ ? "\r\033[K" : "", label_.c_str(), unit_.c_str(), steps, total_, 100.0 * steps / total_,
-               rate, ret, 100.0 * success, format_duration(eta).c_str(), tty_ ? "" : "\n");
+  // Return and success where there are any (a collection has neither).
+  char outcome[64] = "";
+  if (std::isfinite(ret)) std::snprintf(outcome, sizeof outcome, "  return %.1f", ret);
+  if (std::isfinite(success))
+    std::snprintf(outcome + std::strlen(outcome), sizeof outcome - std::strlen(outcome), "  success %.0f%%",
+                  100.0 * success);
+  std::fprintf(stderr, "%s[%s] %s %ld/%ld (%.0f%%)  %s%s  ETA %s%s", tty_ ? "\r\033[K" : "", label_.c_str(),
+               unit_.c_str(), steps, total_, 100.0 * steps / total_, rate, outcome, format_duration(eta).c_str(),
+               tty_ ? "" : "\n");
+  open_ = tty_;
   std::fflush(stderr);
 }
 
 void Progress::finish() {
-  if (tty_) std::fprintf(stderr, "\n");
+  if (open_) std::fprintf(stderr, "\n");
+  open_ = false;
 }
 
 }  // namespace segue

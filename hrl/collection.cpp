@@ -1,5 +1,7 @@
 #include "hrl/collection.h"
 
+#include "core/progress.h"
+
 #include <spdlog/spdlog.h>
 
 #include <sstream>
@@ -24,6 +26,7 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
   StartStates out;
   out.source = r.transition_source(transition);
   out.obs_dim = spec.obs_dim;
+  Progress progress("S_a " + r.transition_name(transition), count, 0, "state");
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {
     if (stop && stop->load()) return out;
     env->reset(mix_seed(seed, e), obs.data());
@@ -43,8 +46,7 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
       done = env->step(act.data(), obs.data()).done();
     }
     // A late interval is reached only as often as every earlier hand-over succeeds.
-    if ((e + 1) % 1000 == 0)
-      spdlog::info("  S_a: {}/{} states after {} episodes (at most {})", out.size(), count, e + 1, max_episodes);
+    progress.update(out.size(), NAN, NAN);
     if (out.size() == 0 && e + 1 == kEmptyEpisodes) {
       max_episodes = e + 1;
       break;
@@ -82,6 +84,7 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
   out.source = r.transition_source(transition);
   out.obs_dim = window.obs_dim = D;
   out.act_dim = window.act_dim = spec.act_dim;
+  Progress progress("T_b " + r.transition_name(transition), count, 0, "step");
   for (int e = 0; e < max_episodes && out.size() < count; ++e) {
     if (stop && stop->load()) return out;
     if (tr.expert_after_handover) {
@@ -119,6 +122,7 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
       }
     }
     if (succeeded || !tr.expert_successful) out.append(window);
+    progress.update(std::min(out.size(), count), NAN, NAN);
     if (out.size() == 0 && e + 1 == kEmptyEpisodes) {
       max_episodes = e + 1;
       break;

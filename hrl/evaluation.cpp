@@ -1,5 +1,9 @@
 #include "hrl/evaluation.h"
 
+#include <optional>
+
+#include "core/progress.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -26,7 +30,8 @@ int slot_count(int jobs) { return std::max(1, std::min(jobs, 32)); }
 // The episode loop: job j starts from seed seed_of(j) and is played by the controller
 // controller_for(slot, j) returns, slot < slot_count(jobs).
 EvalResult run_jobs(const EnvFactory& make_env, int jobs, const std::function<uint64_t(int)>& seed_of,
-                    const std::function<Controller&(int slot, int job)>& controller_for, int threads) {
+                    const std::function<Controller&(int slot, int job)>& controller_for, int threads,
+                    const std::string& label = "") {
   const int slots = slot_count(jobs);
   std::vector<std::unique_ptr<Env>> envs;
   for (int i = 0; i < slots; ++i) envs.push_back(make_env());
@@ -43,6 +48,7 @@ EvalResult run_jobs(const EnvFactory& make_env, int jobs, const std::function<ui
 
   std::vector<float> obs(size_t(slots) * D), act(size_t(slots) * A);
   std::vector<int> job_of(slots, -1);  // -1 idle, -2 just finished
+  std::vector<int> done_job(slots, -1);  // the job a slot just finished
   std::vector<Controller*> controller(slots, nullptr);
   int next = 0;
   auto start = [&](int s) {
@@ -53,6 +59,10 @@ EvalResult run_jobs(const EnvFactory& make_env, int jobs, const std::function<ui
     controller[s]->reset(*envs[s], &obs[size_t(s) * D]);
   };
   for (int s = 0; s < slots; ++s) start(s);
+  std::optional<Progress> progress;
+  if (!label.empty()) progress.emplace(label, jobs, 0, "episode");
+  int finished = 0;
+  double return_sum = 0, success_sum = 0;
 
   ThreadPool pool(threads);
   std::function<void(int, int)> step_block = [&](int begin, int end) {
@@ -70,7 +80,7 @@ EvalResult run_jobs(const EnvFactory& make_env, int jobs, const std::function<ui
         r.successes[e] = sr.info.success;
         r.success_counts[e] = sr.info.success_count;
         for (int k = 0; k < K; ++k) r.metric_means[k][e] /= r.lengths[e];
-        job_of[s] = -2;
+        job_of[s] = -2, done_job[s] = e;
       }
     }
   };
@@ -80,8 +90,14 @@ EvalResult run_jobs(const EnvFactory& make_env, int jobs, const std::function<ui
     if (!any) break;
     pool.parallel_for(slots, step_block);
     for (int s = 0; s < slots; ++s)
-      if (job_of[s] == -2) start(s);
+      if (job_of[s] == -2) {
+        const int e = done_job[s];
+        ++finished, return_sum += r.returns[e], success_sum += r.successes[e];
+        if (progress) progress->update(finished, return_sum / finished, success_sum / finished);
+        start(s);
+      }
   }
+  if (progress) progress->finish();
   return r;
 }
 
@@ -92,13 +108,13 @@ double EvalResult::success_rate() const {
 }
 
 EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_controller, int episodes,
-                    uint64_t seed, int threads) {
+                    uint64_t seed, int threads, const std::string& progress) {
   std::vector<std::unique_ptr<Controller>> controllers;
   for (int i = 0; i < slot_count(episodes); ++i)
     controllers.push_back(make_controller());
   return run_jobs(
       make_env, episodes, [seed](int e) { return mix_seed(seed, e); },
-      [&](int slot, int) -> Controller& { return *controllers[slot]; }, threads);
+      [&](int slot, int) -> Controller& { return *controllers[slot]; }, threads, progress);
 }
 
 std::vector<EvalResult> evaluate_population(const std::vector<Policy>& candidates, const EnvFactory& make_env,
@@ -127,8 +143,9 @@ std::vector<EvalResult> evaluate_population(const std::vector<Policy>& candidate
 }
 
 EvalResult evaluate_policy(const Policy& policy, const EnvFactory& make_env, int episodes, uint64_t seed,
-                           int threads) {
-  return evaluate(make_env, [&] { return std::make_unique<PolicyController>(policy); }, episodes, seed, threads);
+                           int threads, const std::string& progress) {
+  return evaluate(make_env, [&] { return std::make_unique<PolicyController>(policy); }, episodes, seed, threads,
+                  progress);
 }
 
 }  // namespace segue

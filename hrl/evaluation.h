@@ -27,11 +27,12 @@ Summary summarize(const std::vector<double>& xs);  // population std, as numpy's
 using EnvFactory = std::function<std::unique_ptr<Env>()>;
 using ControllerFactory = std::function<std::unique_ptr<Controller>()>;
 
+// `progress`: a label for a progress line on stderr (episodes, rate, ETA); none if empty.
 EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_controller, int episodes,
-                    uint64_t seed, int threads);
+                    uint64_t seed, int threads, const std::string& progress = "");
 // The common case: one deterministic policy.
 EvalResult evaluate_policy(const Policy& policy, const EnvFactory& make_env, int episodes, uint64_t seed,
-                           int threads);
+                           int threads, const std::string& progress = "");
 // Several policies on the same `episodes` seeds (common random numbers: candidate c's
 // episode i starts from mix_seed(seed, i), as evaluate_policy's does), all episodes of
 // all candidates stepped side by side. One EvalResult per candidate, in order.

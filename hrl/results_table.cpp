@@ -43,7 +43,8 @@ std::vector<MethodResult> measure_methods(const CompositeRecipe& r,
     m.method = name;
     std::vector<double> all;
     for (int seed : r.eval_seeds) {
-      EvalResult e = evaluate(r.make_env, controllers, r.eval_episodes, uint64_t(seed), threads);
+      EvalResult e = evaluate(r.make_env, controllers, r.eval_episodes, uint64_t(seed), threads,
+                              name + ", seed " + std::to_string(seed));
       Summary s = summarize(e.success_counts);
       m.seed_means.push_back(s.mean);
       m.seed_stds.push_back(s.std);

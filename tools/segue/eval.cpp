@@ -69,7 +69,7 @@ int eval_main(int argc, char** argv) {
     controllers = [policy] { return std::make_unique<PolicyController>(policy); };
     label = path;
   }
-  EvalResult r = evaluate(make, controllers, episodes, uint64_t(seed), threads);
+  EvalResult r = evaluate(make, controllers, episodes, uint64_t(seed), threads, "eval " + task);
 
   Summary ret = summarize(r.returns), count = summarize(r.success_counts);
   double success = r.success_rate();

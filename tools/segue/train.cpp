@@ -45,7 +45,7 @@ const Command kTrain{
 int finish_run(const Policy& policy, const SkillRecipe& s, const RunDir& dir, int64_t env_steps,
                double wall_seconds, int threads) {
   policy.export_torchscript(dir.file("policy.pt"));
-  EvalResult ev = evaluate_policy(policy, s.eval_make_env, s.eval_episodes, s.eval_seed, threads);
+  EvalResult ev = evaluate_policy(policy, s.eval_make_env, s.eval_episodes, s.eval_seed, threads, "eval " + s.task);
   Summary ret = summarize(ev.returns), count = summarize(ev.success_counts);
   double success = ev.success_rate();
   std::vector<std::pair<std::string, double>> fields{
