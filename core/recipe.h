@@ -7,6 +7,8 @@
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <set>
@@ -126,7 +128,10 @@ T Section::convert(const YAML::Node& node, const std::string& k) const {
     if (!node.IsScalar()) throw bad();
     double d;
     try { d = node.as<double>(); } catch (const YAML::Exception&) { throw bad(); }
-    if (d != static_cast<double>(static_cast<T>(d))) throw bad();
+    // In range before the cast (a cast out of range is undefined; found by the fuzzer).
+    constexpr double hi = double(uint64_t(1) << (std::numeric_limits<T>::digits - 1)) * 2.0;  // 2^digits
+    constexpr double lo = std::is_signed_v<T> ? -hi : 0.0;
+    if (!(d >= lo && d < hi) || d != static_cast<double>(static_cast<T>(d))) throw bad();
     return static_cast<T>(d);
   } else {
     T value;

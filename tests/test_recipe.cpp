@@ -41,6 +41,27 @@ TEST(Recipe, UnknownKeyIsNamedWithASuggestion) {
   }
 }
 
+// An integer key holds an integer its type can hold: 1e30 is refused, not cast (a cast out
+// of range is undefined behaviour; the recipe fuzzer found it), and 2e6 is fine.
+TEST(Recipe, IntegersOutOfTheirRangeAreRefused) {
+  Recipe r = Recipe::parse("ppo: {total_steps: 1e30, num_envs: -1e300, epochs: 3e9, seed: 2e6, nan: .nan}\n", "r.yaml");
+  const Section ppo = r.root().sub("ppo");
+  auto message = [](auto&& read) {
+    try {
+      read();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(message([&] { ppo.get<int64_t>("total_steps", 0); }), "r.yaml: key 'ppo.total_steps' expects an integer, got '1e30'");
+  EXPECT_EQ(message([&] { ppo.get<int>("num_envs", 0); }), "r.yaml: key 'ppo.num_envs' expects an integer, got '-1e300'");
+  EXPECT_EQ(message([&] { ppo.get<int>("epochs", 0); }), "r.yaml: key 'ppo.epochs' expects an integer, got '3e9'");
+  EXPECT_EQ(ppo.get<int64_t>("epochs", 0), 3000000000);
+  EXPECT_EQ(message([&] { ppo.get<int>("nan", 0); }), "r.yaml: key 'ppo.nan' expects an integer, got '.nan'");
+  EXPECT_EQ(ppo.get<int>("seed", 0), 2000000);
+}
+
 TEST(Recipe, WrongTypeAndMalformedYaml) {
   Recipe r = Recipe::parse("ppo: {epochs: many, lr: [1, 2]}\n", "r.yaml");
   try {

@@ -1,8 +1,17 @@
 #!/usr/bin/env bash
-# The test command: installs dependencies, builds, runs the GoogleTest suite with ctest.
+# The test command: installs dependencies, builds, runs the GoogleTest suite with ctest,
+# then the recipe fuzzer for a bounded time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
 bash tools/build.sh
-cd build
-ctest --output-on-failure -j 2 --timeout 600
+(cd build && ctest --output-on-failure -j 2 --timeout 600)
+# The recipe fuzzer (libFuzzer with ASan and UBSan, tests/fuzz/), a bounded run from the
+# seed corpus: any crash, sanitizer report or exception other than segue::Error fails.
+cmake -S tests/fuzz -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ >/dev/null
+cmake --build build-fuzz
+corpus=$(mktemp -d)
+cp tests/fuzz/corpus/* "$corpus"/
+build-fuzz/fuzz_recipe -max_total_time="${SEGUE_FUZZ_SECONDS:-60}" -timeout=10 -rss_limit_mb=2048 \
+  -print_final_stats=1 -artifact_prefix=build-fuzz/ "$corpus" 2>&1 | tail -3
+rm -rf "$corpus"
