@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The test command: installs dependencies, builds, runs the GoogleTest suite with ctest,
-# then the recipe fuzzer for a bounded time.
+# the recipe fuzzer for a bounded time, then the suite again built with ASan and UBSan.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install_deps.sh
@@ -15,3 +15,12 @@ cp tests/fuzz/corpus/* "$corpus"/
 build-fuzz/fuzz_recipe -max_total_time="${SEGUE_FUZZ_SECONDS:-60}" -timeout=10 -rss_limit_mb=2048 \
   -print_final_stats=1 -artifact_prefix=build-fuzz/ "$corpus" 2>&1 | tail -3
 rm -rf "$corpus"
+# The suite under AddressSanitizer and UndefinedBehaviorSanitizer (build-asan/), less the
+# tests that measure learning or time kills (slow there, and no other code paths):
+# Jaco.PpoImprovesThePickReturn, PpoLearning.*, EvolutionStrategy.Improves*, KillSoak.*,
+# and the Python tools. LeakSanitizer is off: LibTorch and MuJoCo keep process-lifetime
+# allocations.
+cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Release -DSEGUE_SANITIZE=ON >/dev/null
+cmake --build build-asan -j "$(nproc)"
+(cd build-asan && ASAN_OPTIONS=detect_leaks=0 ctest --output-on-failure -j 2 --timeout 900 \
+  -E '^(Jaco\.PpoImprovesThePickReturn|PpoLearning\..*|EvolutionStrategy\.Improves.*|KillSoak\..*|TsneTool|PlotTool)$')
