@@ -66,7 +66,6 @@ Demonstrations demonstrations_of(const CompositeRecipe& r, int t, const std::str
   return d;
 }
 
-// Returns the signal number when stopped (nothing of the unfinished set is kept), else 0.
 // With several ranks each collects its share (its own episode seeds) into FILE.partR,
 // and rank 0 joins the parts in rank order into FILE.
 template <class Items, class Collect>
@@ -92,6 +91,7 @@ int collect_shared(const Distributed& group, const std::string& file, int count,
   return 0;
 }
 
+// Returns the signal number when stopped (nothing of the unfinished set is kept), else 0.
 int collect(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
             const std::atomic<int>* stop, const Distributed& group) {
   const CollectConfig& c = r.pipeline.collect;
@@ -122,6 +122,11 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
     if (tr.expert_after_handover) {
       handovers = starts_of(r, t, dir);
       handovers.keep_first(handovers.size() - r.pipeline.switching.validation_starts);
+      // Each rank takes over at its own block of them.
+      const Shard mine = group.shard(handovers.size(), dir + "/start_states.pt");
+      handovers.states.erase(handovers.states.begin(), handovers.states.begin() + size_t(mine.first) * handovers.state_dim);
+      handovers.obs.erase(handovers.obs.begin(), handovers.obs.begin() + size_t(mine.first) * handovers.obs_dim);
+      handovers.keep_first(mine.count);
     }
     return collect_shared<Demonstrations>(
         group, dir + "/demonstrations.pt", c.demonstrations, mix_seed(r.pipeline.seed, 2 * t + 1), stop,
