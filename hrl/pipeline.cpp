@@ -26,6 +26,12 @@ bool exists(const std::string& path) { return fs::exists(path); }
 // The signal number that asked the run to stop, or 0.
 int signal_of(const std::atomic<int>* stop) { return stop ? stop->load() : 0; }
 
+// Whether to stop, agreed by every rank (a collective): the signal number if any rank saw
+// one (1 where this rank did not), else 0.
+int agreed_stop(const Distributed& group, const std::atomic<int>* stop) {
+  return group.any(signal_of(stop) != 0) ? std::max(signal_of(stop), 1) : 0;
+}
+
 // Exports transition t's trained `file` (policy.pt, lee.pt, q.pt) into its folder, saying
 // what it is for (checked by load_transition_artefacts).
 void export_artefact(Policy p, const CompositeRecipe& r, int t, const std::string& dir, const std::string& file) {
@@ -73,7 +79,7 @@ int collect_shared(const Distributed& group, const std::string& file, int count,
                    const std::atomic<int>* stop, Collect collect, Items (*load)(const std::string&)) {
   const Shard share = group.shard(count, file);
   Items items = collect(share.count, group.single() ? seed : mix_seed(seed, 0xc011 + group.rank()));
-  if (const int sig = group.any(signal_of(stop) != 0) ? std::max(signal_of(stop), 1) : 0) return sig;
+  if (const int sig = agreed_stop(group, stop)) return sig;
   if (group.single()) {
     save(items, file);
     return 0;
@@ -159,7 +165,7 @@ int train_loop(Trainer& trainer, const CompositeRecipe& r, int64_t total_steps, 
     if (s.ppo.episodes > 0) recent = s.ppo.success_rate;
     if (csv) csv->write(row(s));
     bool last = trainer.ppo().global_step() >= total_steps;
-    const int stop = group.any(signal_of(o.stop) != 0) ? std::max(signal_of(o.stop), 1) : 0;
+    const int stop = agreed_stop(group, o.stop);
     if (last || stop || s.ppo.iteration % 10 == 0) trainer.save(ckpt, r.resolved);
     if (progress) progress->update(trainer.ppo().global_step(), s.ppo.episode_return, recent);
     if (stop && !last) {
@@ -269,7 +275,7 @@ int train_switch(const CompositeRecipe& r, int t, const std::string& run, const 
     spdlog::info("  q_ab: {}/{} attempts, epsilon {:.2f}, pi_b succeeded in {:.0f}%, switch at step {:.1f}",
                  trainer.attempts_done(), cfg.attempts, s.epsilon, 100 * s.success_rate, s.switch_step);
     trainer.save(ckpt);
-    const int sig = group.any(signal_of(stop) != 0) ? std::max(signal_of(stop), 1) : 0;
+    const int sig = agreed_stop(group, stop);
     if (sig && trainer.attempts_done() < cfg.attempts) return sig;
   }
   if (!group.leader()) {

@@ -19,23 +19,12 @@
 #include "core/distributed.h"
 #include "hrl/collection.h"
 #include "tests/cli_run.h"
+#include "tests/csv.h"
 #include "tests/temp_dir.h"
 #include "tests/tiny_patrol.h"
 
 namespace segue {
 namespace {
-
-std::vector<std::vector<std::string>> csv(const std::string& path) {
-  std::vector<std::vector<std::string>> rows;
-  std::ifstream in(path);
-  for (std::string line; std::getline(in, line);) {
-    std::vector<std::string> row;
-    std::stringstream ss(line);
-    for (std::string cell; std::getline(ss, cell, ',');) row.push_back(cell);
-    rows.push_back(row);
-  }
-  return rows;
-}
 
 bool timing(const std::string& column) { return column.find("seconds") != std::string::npos; }
 
@@ -151,6 +140,24 @@ TEST_F(DataParallel, TwoRanksTrainWhatOneProcessTrains) {
   }
 }
 
+// `segue train FILE --nproc 2` in the background, its stderr into `log`; returns the
+// launcher's pid once RUN_DIR/metrics.csv has `rows` iterations (or after two minutes).
+pid_t start_two_ranks(const std::string& file, const std::string& run_dir, size_t rows, const std::string& log,
+                      const char* timeout_s = nullptr) {
+  const pid_t launcher = fork();
+  if (launcher == 0) {
+    freopen(log.c_str(), "w", stderr);
+    freopen("/dev/null", "w", stdout);
+    if (timeout_s) setenv("SEGUE_DIST_TIMEOUT", timeout_s, 1);
+    execl(SEGUE_BINARY, SEGUE_BINARY, "train", file.c_str(), "--nproc", "2", static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (csv(run_dir + "/metrics.csv").size() < rows + 1 && std::chrono::steady_clock::now() < deadline)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  return launcher;
+}
+
 // The children of a process (the launcher's ranks), in start order.
 std::vector<pid_t> children(pid_t pid) {
   std::ifstream in("/proc/" + std::to_string(pid) + "/task/" + std::to_string(pid) + "/children");
@@ -163,17 +170,8 @@ TEST_F(DataParallel, AKilledRankStopsTheOthersAndTheRerunResumesToTheUnbrokenRun
   const int iterations = 24;
   train(recipe("unbroken", iterations, 2, 128), "--nproc 2");
   const std::string file = recipe("killed", iterations, 2, 128);
-  const pid_t launcher = fork();
-  if (launcher == 0) {
-    freopen("/dev/null", "w", stdout);
-    freopen("/dev/null", "w", stderr);
-    execl(SEGUE_BINARY, SEGUE_BINARY, "train", file.c_str(), "--nproc", "2", static_cast<char*>(nullptr));
-    _exit(127);
-  }
   // Rank 1 dies (SIGKILL: no checkpoint of its own) once a few iterations are in.
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (csv(path("killed") + "/metrics.csv").size() < 4 && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const pid_t launcher = start_two_ranks(file, path("killed"), 3, "/dev/null");
   const std::vector<pid_t> ranks = children(launcher);
   ASSERT_EQ(ranks.size(), 2u);
   ::kill(ranks[1], SIGKILL);
@@ -277,17 +275,7 @@ TEST_F(DataParallel, TheMethodRunsOnTwoRanks) {
 TEST_F(DataParallel, AHungRankStopsTheOthersWithinTheTimeout) {
   const std::string file = recipe("hung", 400);
   const std::string log = path("hung.log");
-  const pid_t launcher = fork();
-  if (launcher == 0) {
-    freopen(log.c_str(), "w", stderr);
-    freopen("/dev/null", "w", stdout);
-    setenv("SEGUE_DIST_TIMEOUT", "2", 1);
-    execl(SEGUE_BINARY, SEGUE_BINARY, "train", file.c_str(), "--nproc", "2", static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (csv(path("hung") + "/metrics.csv").size() < 3 && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  const pid_t launcher = start_two_ranks(file, path("hung"), 2, log, "2");
   const std::vector<pid_t> ranks = children(launcher);
   ASSERT_EQ(ranks.size(), 2u);
   ::kill(ranks[1], SIGSTOP);

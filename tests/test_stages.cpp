@@ -15,6 +15,7 @@
 
 #include "core/run_dir.h"
 #include "tests/cli_run.h"
+#include "tests/csv.h"
 #include "tests/temp_dir.h"
 
 namespace segue {
@@ -46,18 +47,6 @@ void expect_same_rows(const std::vector<std::vector<std::string>>& a, const std:
       EXPECT_EQ(a[r][c], b[r][c]) << "row " << r << " column " << name;
     }
   }
-}
-
-std::vector<std::vector<std::string>> csv(const std::string& path) {
-  std::vector<std::vector<std::string>> rows;
-  std::ifstream in(path);
-  for (std::string line; std::getline(in, line);) {
-    std::vector<std::string> row;
-    std::stringstream ss(line);
-    for (std::string cell; std::getline(ss, cell, ',');) row.push_back(cell);
-    rows.push_back(row);
-  }
-  return rows;
 }
 
 class Stages : public TempDirTest {
