@@ -7,6 +7,7 @@
 #include <numeric>
 #include <sstream>
 
+#include "algorithms/ppo.h"  // kMaxEnvs
 #include "core/error.h"
 #include "core/rng.h"
 #include "core/run_dir.h"
@@ -15,21 +16,15 @@ namespace segue {
 
 EsConfig EsConfig::read(const Section& s) {
   EsConfig c;
-  c.generations = s.get("generations", c.generations);
-  c.pairs = s.get("pairs", c.pairs);
-  c.episodes = s.get("episodes", c.episodes);
-  c.sigma = s.get("sigma", c.sigma);
-  c.lr = s.get("lr", c.lr);
-  c.inputs = s.get("inputs", c.inputs);
-  c.fitness = s.get("fitness", c.fitness);
-  if (c.fitness != "success" && c.fitness != "return") throw s.error("fitness", "must be 'success' or 'return'");
-  if (!c.inputs.empty() && (c.inputs.size() != 2 || c.inputs[0] < 0 || c.inputs[0] >= c.inputs[1]))
+  c.generations = s.get("generations", c.generations, Range::positive());
+  c.pairs = s.get("pairs", c.pairs, Range::closed(1, kMaxEnvs));  // each pair is two environments
+  c.episodes = s.get("episodes", c.episodes, Range::positive());
+  c.sigma = s.get("sigma", c.sigma, Range::positive());
+  c.lr = s.get("lr", c.lr, Range::positive());
+  c.inputs = s.get("inputs", c.inputs, Range::non_negative());
+  c.fitness = s.choice("fitness", c.fitness, {"success", "return"});
+  if (!c.inputs.empty() && (c.inputs.size() != 2 || c.inputs[0] >= c.inputs[1]))
     throw s.error("inputs", "must be [begin, end) with 0 <= begin < end");
-  if (c.generations <= 0) throw s.error("generations", "must be positive");
-  if (c.pairs <= 0) throw s.error("pairs", "must be positive");
-  if (c.episodes <= 0) throw s.error("episodes", "must be positive");
-  if (!(c.sigma > 0)) throw s.error("sigma", "must be positive");
-  if (!(c.lr > 0)) throw s.error("lr", "must be positive");
   return c;
 }
 

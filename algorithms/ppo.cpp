@@ -12,46 +12,29 @@
 namespace segue {
 
 PpoConfig PpoConfig::read(const Section& s, PpoConfig c) {
-  c.total_steps = s.get("total_steps", c.total_steps);
-  c.num_envs = s.get("num_envs", c.num_envs);
-  c.steps_per_env = s.get("steps_per_env", c.steps_per_env);
-  c.epochs = s.get("epochs", c.epochs);
-  c.minibatch_size = s.get("minibatch_size", c.minibatch_size);
-  c.lr = s.get("lr", c.lr);
+  // Sizes are bounded before anything is allocated: a typo of 1e9 environments must not
+  // exhaust memory.
+  c.total_steps = s.get("total_steps", c.total_steps, Range::positive());
+  c.num_envs = s.get("num_envs", c.num_envs, Range::closed(1, kMaxEnvs));
+  c.steps_per_env = s.get("steps_per_env", c.steps_per_env, Range::closed(1, kMaxStepsPerEnv));
+  c.epochs = s.get("epochs", c.epochs, Range::positive());
+  c.minibatch_size = s.get("minibatch_size", c.minibatch_size, Range::positive());
+  c.lr = s.get("lr", c.lr, Range::positive());
   c.anneal_lr = s.get("anneal_lr", c.anneal_lr);
-  c.gamma = s.get("gamma", c.gamma);
-  c.lambda = s.get("lambda", c.lambda);
-  c.clip = s.get("clip", c.clip);
-  c.vf_coef = s.get("vf_coef", c.vf_coef);
-  c.ent_coef = s.get("ent_coef", c.ent_coef);
-  c.min_log_std = s.get("min_log_std", c.min_log_std);
-  c.noise_repeat = s.get("noise_repeat", c.noise_repeat);
-  c.bound_coef = s.get("bound_coef", c.bound_coef);
-  c.max_grad_norm = s.get("max_grad_norm", c.max_grad_norm);
+  c.gamma = s.get("gamma", c.gamma, Range::open_closed(0, 1));
+  c.lambda = s.get("lambda", c.lambda, Range::closed(0, 1));
+  c.clip = s.get("clip", c.clip, Range::positive());
+  c.vf_coef = s.get("vf_coef", c.vf_coef, Range::non_negative());
+  c.ent_coef = s.get("ent_coef", c.ent_coef, Range::non_negative());
+  c.min_log_std = s.get("min_log_std", c.min_log_std, Range::any());
+  c.noise_repeat = s.get("noise_repeat", c.noise_repeat, Range::positive());
+  c.bound_coef = s.get("bound_coef", c.bound_coef, Range::non_negative());
+  c.max_grad_norm = s.get("max_grad_norm", c.max_grad_norm, Range::positive());
   c.normalize_reward = s.get("normalize_reward", c.normalize_reward);
-  c.obs_clip = s.get("obs_clip", c.obs_clip);
-  if (c.total_steps <= 0) throw s.error("total_steps", "must be positive, got " + std::to_string(c.total_steps));
-  // Checked before anything is allocated: a typo of 1e9 environments must not exhaust memory.
-  if (c.num_envs <= 0 || c.num_envs > kMaxEnvs)
-    throw s.error("num_envs", "must be in [1, " + std::to_string(kMaxEnvs) + "], got " + std::to_string(c.num_envs));
-  if (c.steps_per_env > kMaxStepsPerEnv)
-    throw s.error("steps_per_env", "must be at most " + std::to_string(kMaxStepsPerEnv));
+  c.obs_clip = s.get("obs_clip", c.obs_clip, Range::positive());
   if (c.minibatch_size > int64_t(c.num_envs) * c.steps_per_env)
     throw s.error("minibatch_size", std::to_string(c.minibatch_size) + " is larger than a rollout (num_envs x steps_per_env = " +
                                         std::to_string(int64_t(c.num_envs) * c.steps_per_env) + ")");
-  if (!(c.clip > 0)) throw s.error("clip", "must be > 0");
-  if (!(c.vf_coef >= 0)) throw s.error("vf_coef", "must be >= 0");
-  if (!(c.ent_coef >= 0)) throw s.error("ent_coef", "must be >= 0");
-  if (!(c.max_grad_norm > 0)) throw s.error("max_grad_norm", "must be > 0");
-  if (!(c.obs_clip > 0)) throw s.error("obs_clip", "must be > 0");
-  if (c.steps_per_env <= 0) throw s.error("steps_per_env", "must be positive");
-  if (c.minibatch_size <= 0) throw s.error("minibatch_size", "must be positive");
-  if (c.epochs <= 0) throw s.error("epochs", "must be positive");
-  if (c.noise_repeat <= 0) throw s.error("noise_repeat", "must be positive");
-  if (!(c.lr > 0)) throw s.error("lr", "must be positive");
-  if (!(c.bound_coef >= 0)) throw s.error("bound_coef", "must be >= 0");
-  if (!(c.gamma > 0 && c.gamma <= 1)) throw s.error("gamma", "must be in (0, 1]");
-  if (!(c.lambda >= 0 && c.lambda <= 1)) throw s.error("lambda", "must be in [0, 1]");
   return c;
 }
 
@@ -540,9 +523,13 @@ void PPO::load(const std::string& path, const ArchiveReader& extra, bool resume_
 
 void PPO::read_state(torch::serialize::InputArchive& ar, const std::string& path) {
   torch::Tensor dims;
-  ar.read("meta_dims", dims);
-  if (dims[0].item<int64_t>() != net_->spec.obs_dim || dims[1].item<int64_t>() != net_->spec.act_dim)
-    throw Error(path + ": checkpoint sizes do not match the task");
+  if (!ar.try_read("meta_dims", dims))
+    throw Error(path + ": not a training checkpoint (an exported policy? a run starts from one with init_policy)");
+  const int64_t obs = dims[0].item<int64_t>(), act = dims[1].item<int64_t>();
+  if (obs != net_->spec.obs_dim || act != net_->spec.act_dim)
+    throw Error(path + ": the checkpoint's policy takes obs_dim " + std::to_string(obs) + " / act_dim " +
+                std::to_string(act) + ", the task " + std::to_string(net_->spec.obs_dim) + " / " +
+                std::to_string(net_->spec.act_dim));
   if (!(read_features(ar) == net_->spec.features))
     throw Error(path + ": checkpoint's policy.fourier features differ from the recipe's");
   torch::NoGradGuard no_grad;

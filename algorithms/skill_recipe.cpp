@@ -9,12 +9,11 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   SkillRecipe s;
   s.task = root.require<std::string>("task");
   s.seed = root.get<uint64_t>("seed", s.seed);
-  s.threads = root.get("threads", s.threads);
-  if (s.threads < 0) throw root.error("threads", "must be >= 0 (0: all cores)");
+  s.threads = root.get("threads", s.threads, Range::non_negative());  // 0: all cores
   s.run_dir = root.get("run_dir", default_run_dir);
-  s.checkpoint_every = root.get("checkpoint_every", s.checkpoint_every);
+  s.checkpoint_every = root.get("checkpoint_every", s.checkpoint_every, Range::positive());
   s.init_from = root.get<std::string>("init_from", "");
-  s.init_log_std = root.get("init_log_std", s.init_log_std);
+  s.init_log_std = root.get("init_log_std", s.init_log_std, Range::any());
   s.init_policy = root.get<std::string>("init_policy", "");
   if (!s.init_policy.empty() && !s.init_from.empty())
     throw root.error("init_policy", "a run starts from init_from or init_policy, not both");
@@ -23,23 +22,13 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   s.restart_lr_schedule = root.get("restart_lr_schedule", s.restart_lr_schedule);
   if (s.restart_lr_schedule && s.init_from.empty())
     throw root.error("restart_lr_schedule", "applies to a run that starts from init_from");
-  try {
-    s.make_env = task_factory(s.task, root.sub("env"));
-  } catch (const Error& e) {
-    if (std::string(e.what()).rfind("unknown task", 0) == 0) throw root.error("task", e.what());
-    throw;
-  }
+  s.make_env = read_task(root, s.task);
   Section pol = root.sub("policy");
   s.net.pi_hidden = pol.layers("pi_hidden", s.net.pi_hidden);
   s.net.vf_hidden = pol.layers("vf_hidden", s.net.vf_hidden);
-  std::string act = pol.get<std::string>("activation", "tanh");
-  try {
-    s.net.activation = parse_activation(act);
-  } catch (const Error& e) {
-    throw pol.error("activation", e.what());
-  }
-  s.net.init_log_std = pol.get("init_log_std", s.net.init_log_std);
-  s.net.ignore_obs = pol.get("ignore_obs", s.net.ignore_obs);
+  s.net.activation = parse_activation(pol.choice("activation", "tanh", {"tanh", "relu"}));
+  s.net.init_log_std = pol.get("init_log_std", s.net.init_log_std, Range::any());
+  s.net.ignore_obs = pol.get("ignore_obs", s.net.ignore_obs, Range::non_negative());
   if (root.has("es")) {
     s.es = EsConfig::read(root.sub("es"));
     if (s.init_policy.empty()) throw root.error("es", "fine-tunes a trained policy: give init_policy too");
@@ -48,17 +37,15 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   }
   s.ppo = PpoConfig::read(root.sub("ppo"));
   Section ev = root.sub("eval");
-  s.eval_episodes = ev.get("episodes", s.eval_episodes);
+  s.eval_episodes = ev.get("episodes", s.eval_episodes, Range::positive());
   s.eval_seed = ev.get<uint64_t>("seed", s.eval_seed);
-  if (s.eval_episodes <= 0) throw ev.error("episodes", "must be positive");
   s.eval_make_env = s.make_env;
   if (ev.get("reference_task", false))
     s.eval_make_env = reference_task_factory(s.task);
-  if (s.checkpoint_every <= 0) throw root.error("checkpoint_every", "must be positive");
   auto probe = s.make_env();
   s.net.obs_dim = probe->spec().obs_dim;
   const auto& ig = s.net.ignore_obs;
-  if (!ig.empty() && (ig.size() != 2 || ig[0] < 0 || ig[0] >= ig[1] || ig[1] > s.net.obs_dim))
+  if (!ig.empty() && (ig.size() != 2 || ig[0] >= ig[1] || ig[1] > s.net.obs_dim))
     throw pol.error("ignore_obs", "must be [begin, end) with 0 <= begin < end <= " + std::to_string(s.net.obs_dim));
   // Read only when given, so older runs' resolved recipes stay the same.
   if (pol.has("fourier")) s.net.features = ObsFeatures::read(pol.sub("fourier"), s.net.obs_dim);

@@ -1,6 +1,7 @@
 #include "core/recipe.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -143,11 +144,36 @@ std::optional<YAML::Node> Section::lookup_value(const std::string& full_key) con
   return std::nullopt;
 }
 
-std::vector<int> Section::layers(const std::string& key, const std::vector<int>& fallback) const {
-  std::vector<int> widths = get(key, fallback);
-  for (int w : widths)
-    if (w <= 0) throw error(key, "layer widths must be positive, got " + std::to_string(w));
-  return widths;
+namespace {
+std::string number_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.10g", v);
+  return buf;
+}
+}  // namespace
+
+std::string Range::text() const {
+  const bool low = std::isfinite(lo), high = std::isfinite(hi);
+  if (low && high) return std::string("in ") + (lo_open ? "(" : "[") + number_text(lo) + ", " + number_text(hi) + (hi_open ? ")" : "]");
+  if (low) return (lo_open ? "> " : ">= ") + number_text(lo);
+  if (high) return (hi_open ? "< " : "<= ") + number_text(hi);
+  return "any";
+}
+
+void Section::refuse(const std::string& k, double value, const Range& range, bool each) const {
+  throw Error(s_->file + ": key '" + k + "' must " + (each ? "hold numbers " : "be ") + range.text() + ", got " +
+              number_text(value));
+}
+
+std::string Section::choice(const std::string& key, const std::string& fallback,
+                            const std::vector<std::string>& choices) const {
+  const std::string value = get(key, fallback);
+  std::string listed;
+  for (size_t i = 0; i < choices.size(); ++i) listed += (i ? ", " : "") + choices[i];
+  s_->rules[full(key)].accepts = "one of " + listed;
+  if (std::find(choices.begin(), choices.end(), value) == choices.end())
+    throw Error(s_->file + ": key '" + full(key) + "' must be one of " + listed + ", got '" + value + "'");
+  return value;
 }
 
 void Section::record(const std::string& full_key, const YAML::Node& value) const {
@@ -292,6 +318,8 @@ void Recipe::reject_unknown() const {
 }
 
 const std::set<std::string>& Recipe::defaulted_keys() const { return s_->defaulted; }
+
+const std::map<std::string, KeyRule>& Recipe::key_rules() const { return s_->rules; }
 
 std::string Recipe::resolved_yaml() const {
   YAML::Emitter e;

@@ -1,14 +1,16 @@
 #pragma once
 // YAML recipes with strict key checking. Code declares the keys it understands by
-// reading them (with a default, or required); after everything is read,
-// reject_unknown() refuses any key nobody read, which catches typos like "ppo.lrr".
-// The values actually used, defaults included, form the resolved recipe that a run
-// directory records.
+// reading them (with a default, or required, and the values a number may take); after
+// everything is read, reject_unknown() refuses any key nobody read, which catches typos
+// like "ppo.lrr". The values actually used, defaults included, form the resolved recipe
+// that a run directory records; each key's type and range, declared where it is read,
+// form the table the recipe reference (docs/recipes.md, `segue keys`) is printed from.
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 #include <set>
@@ -21,13 +23,44 @@ namespace segue {
 
 class Recipe;
 
+// The values a number (or each number of a list) may take, checked where its key is read.
+struct Range {
+  double lo = -HUGE_VAL, hi = HUGE_VAL;
+  bool lo_open = false, hi_open = false;
+  static Range any() { return {}; }
+  static Range positive() { return {0, HUGE_VAL, true, false}; }
+  static Range non_negative() { return {0, HUGE_VAL, false, false}; }
+  static Range at_least(double lo) { return {lo, HUGE_VAL, false, false}; }
+  static Range above(double lo) { return {lo, HUGE_VAL, true, false}; }
+  static Range at_most(double hi) { return {-HUGE_VAL, hi, false, false}; }
+  static Range closed(double lo, double hi) { return {lo, hi, false, false}; }
+  static Range open_closed(double lo, double hi) { return {lo, hi, true, false}; }
+  static Range closed_open(double lo, double hi) { return {lo, hi, false, true}; }
+  bool contains(double v) const {
+    return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
+  }
+  std::string text() const;  // "> 0", "in (0, 1]", "any"
+};
+
+// What the reference lists for a key: its type, and what it accepts ("" where undeclared).
+struct KeyRule {
+  std::string type, accepts;
+};
+
 // A view of one mapping inside a recipe, e.g. the "ppo" section.
 class Section {
  public:
   template <class T>
   T get(const std::string& key, const T& fallback) const;
+  // A number, or a list of numbers, refused unless (each) in `range`.
+  template <class T>
+  T get(const std::string& key, const T& fallback, const Range& range) const;
   template <class T>
   T require(const std::string& key) const;
+  template <class T>
+  T require(const std::string& key, const Range& range) const;
+  // A string that must be one of `choices`.
+  std::string choice(const std::string& key, const std::string& fallback, const std::vector<std::string>& choices) const;
   bool has(const std::string& key) const;
   bool is_sequence(const std::string& key) const;
   Section sub(const std::string& key) const;
@@ -39,7 +72,9 @@ class Section {
   // "FILE: key 'a.b': msg" — the one-line error for a bad value found after reading.
   Error error(const std::string& key, const std::string& msg) const;
   // A network's hidden layer widths (`pi_hidden: [64, 64]`): a list of positive integers.
-  std::vector<int> layers(const std::string& key, const std::vector<int>& fallback) const;
+  std::vector<int> layers(const std::string& key, const std::vector<int>& fallback) const {
+    return get(key, fallback, Range::at_least(1));
+  }
 
  private:
   friend class Recipe;
@@ -55,6 +90,11 @@ class Section {
   template <class T>
   T convert(const YAML::Node& node, const std::string& full_key) const;
   void record(const std::string& full_key, const YAML::Node& value) const;
+  template <class T>
+  void note_type(const std::string& full_key) const;
+  template <class T>
+  void check(const std::string& full_key, const T& value, const Range& range, bool given) const;
+  void refuse(const std::string& full_key, double value, const Range& range, bool each) const;
   std::shared_ptr<State> s_;
   std::string prefix_;
 };
@@ -72,6 +112,8 @@ class Recipe {
   std::string resolved_yaml() const;
   // The keys among them that the recipe left to their defaults ("ppo.noise_repeat").
   const std::set<std::string>& defaulted_keys() const;
+  // Each key read so far with its type and range ("transitions.0.max_steps": items by index).
+  const std::map<std::string, KeyRule>& key_rules() const;
   // The recipe's `stages:` list (a curriculum), each item as written (empty: none).
   std::vector<YAML::Node> stages() const;
   // This recipe without its stages, with `overrides` laid over it (mappings merged key by
@@ -90,7 +132,35 @@ struct Section::State {
   std::set<std::string> read;
   std::set<std::string> overridden;
   std::set<std::string> defaulted;  // keys read whose value is the code's default
+  std::map<std::string, KeyRule> rules;
 };
+
+// Type names for messages.
+template <class T> const char* type_name();
+
+template <class T>
+void Section::note_type(const std::string& k) const {
+  KeyRule& rule = s_->rules[k];
+  rule.type = type_name<T>();
+  if constexpr (std::is_unsigned_v<T> && !std::is_same_v<T, bool>) {
+    if (rule.accepts.empty()) rule.accepts = ">= 0";  // the conversion refuses the rest
+  }
+}
+
+template <class T>
+void Section::check(const std::string& k, const T& value, const Range& range, bool given) const {
+  constexpr bool number = std::is_arithmetic_v<T> && !std::is_same_v<T, bool>;
+  static_assert(number || std::is_same_v<T, std::vector<int>> || std::is_same_v<T, std::vector<double>>,
+                "a Range applies to numbers and lists of numbers");
+  s_->rules[k].accepts = (number || range.text() == "any" ? "" : "each ") + range.text();
+  if (!given) return;
+  if constexpr (number) {
+    if (!range.contains(double(value))) refuse(k, double(value), range, false);
+  } else {
+    for (auto v : value)
+      if (!range.contains(double(v))) refuse(k, double(v), range, true);
+  }
+}
 
 template <class T>
 T Section::get(const std::string& key, const T& fallback) const {
@@ -98,7 +168,16 @@ T Section::get(const std::string& key, const T& fallback) const {
   auto node = lookup_value(k);
   T value = node ? convert<T>(*node, k) : fallback;
   if (!node) s_->defaulted.insert(k);
+  note_type<T>(k);
   record(k, YAML::Node(value));
+  return value;
+}
+
+template <class T>
+T Section::get(const std::string& key, const T& fallback, const Range& range) const {
+  T value = get(key, fallback);
+  // The code's own default may stand outside the range (NaN for "not set").
+  check(full(key), value, range, /*given=*/!s_->defaulted.count(full(key)));
   return value;
 }
 
@@ -108,12 +187,17 @@ T Section::require(const std::string& key) const {
   auto node = lookup_value(k);
   if (!node) throw Error(s_->file + ": missing required key '" + k + "'");
   T value = convert<T>(*node, k);
+  note_type<T>(k);
   record(k, YAML::Node(value));
   return value;
 }
 
-// Type names for messages.
-template <class T> const char* type_name();
+template <class T>
+T Section::require(const std::string& key, const Range& range) const {
+  T value = require<T>(key);
+  check(full(key), value, range, true);
+  return value;
+}
 
 template <class T>
 T Section::convert(const YAML::Node& node, const std::string& k) const {

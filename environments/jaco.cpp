@@ -10,21 +10,18 @@ double distance(const Vec3& a, const Vec3& b) {
 }
 
 Vec3 read_vec3(const Section& env, const std::string& key, const Vec3& fallback) {
-  auto v = env.get(key, std::vector<double>(fallback.begin(), fallback.end()));
+  auto v = env.get(key, std::vector<double>(fallback.begin(), fallback.end()), Range::any());
   if (v.size() != 3) throw env.error(key, "must be a list of 3 numbers (x, y, z)");
   return {v[0], v[1], v[2]};
 }
 
 JacoConfig JacoConfig::read(const Section& s, JacoConfig c) {
-  c.max_episode_steps = s.get("max_episode_steps", c.max_episode_steps);
-  c.init_noise = s.get("init_noise", c.init_noise);
-  c.init_random_steps = s.get("init_random_steps", c.init_random_steps);
-  c.ctrl_cost = s.get("ctrl_cost", c.ctrl_cost);
-  c.qvel_cost = s.get("qvel_cost", c.qvel_cost);
-  c.qacc_cost = s.get("qacc_cost", c.qacc_cost);
-  if (c.max_episode_steps <= 0) throw s.error("max_episode_steps", "must be positive");
-  if (c.init_random_steps < 0) throw s.error("init_random_steps", "must be >= 0");
-  if (!(c.init_noise >= 0)) throw s.error("init_noise", "must be >= 0");
+  c.max_episode_steps = s.get("max_episode_steps", c.max_episode_steps, Range::positive());
+  c.init_noise = s.get("init_noise", c.init_noise, Range::non_negative());
+  c.init_random_steps = s.get("init_random_steps", c.init_random_steps, Range::non_negative());
+  c.ctrl_cost = s.get("ctrl_cost", c.ctrl_cost, Range::non_negative());
+  c.qvel_cost = s.get("qvel_cost", c.qvel_cost, Range::non_negative());
+  c.qacc_cost = s.get("qacc_cost", c.qacc_cost, Range::non_negative());
   return c;
 }
 

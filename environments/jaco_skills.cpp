@@ -7,21 +7,20 @@ namespace segue {
 
 PickRule::Config PickRule::Config::read(const Section& e) {
   Config c;
-  c.in_hand = e.get("in_hand", c.in_hand);
-  c.in_air = e.get("in_air", c.in_air);
+  c.in_hand = e.get("in_hand", c.in_hand, Range::positive());
+  c.in_air = e.get("in_air", c.in_air, Range::non_negative());
   c.tile = read_vec3(e, "tile", c.tile);
-  c.tile_size = e.get("tile_size", c.tile_size);
-  c.quat_noise = e.get("quat_noise", c.quat_noise);
-  c.vel_noise = e.get("vel_noise", c.vel_noise);
-  c.guide_weight = e.get("guide_weight", c.guide_weight);
-  c.lift_weight = e.get("lift_weight", c.lift_weight);
-  c.lift_cap = e.get("lift_cap", c.lift_cap);
-  c.hold_height = e.get("hold_height", c.hold_height);
-  c.hold_weight = e.get("hold_weight", c.hold_weight);
-  c.hold_steps = e.get("hold_steps", c.hold_steps);
-  c.time_bonus = e.get("time_bonus", c.time_bonus);
-  c.center_weight = e.get("center_weight", c.center_weight);
-  if (c.hold_steps < 1) throw e.error("hold_steps", "must be at least 1");
+  c.tile_size = e.get("tile_size", c.tile_size, Range::non_negative());
+  c.quat_noise = e.get("quat_noise", c.quat_noise, Range::non_negative());
+  c.vel_noise = e.get("vel_noise", c.vel_noise, Range::non_negative());
+  c.guide_weight = e.get("guide_weight", c.guide_weight, Range::non_negative());
+  c.lift_weight = e.get("lift_weight", c.lift_weight, Range::non_negative());
+  c.lift_cap = e.get("lift_cap", c.lift_cap, Range::positive());
+  c.hold_height = e.get("hold_height", c.hold_height, Range::positive());
+  c.hold_weight = e.get("hold_weight", c.hold_weight, Range::non_negative());
+  c.hold_steps = e.get("hold_steps", c.hold_steps, Range::at_least(1));
+  c.time_bonus = e.get("time_bonus", c.time_bonus, Range::non_negative());
+  c.center_weight = e.get("center_weight", c.center_weight, Range::non_negative());
   return c;
 }
 
@@ -67,19 +66,18 @@ RuleStep PickRule::step(const JacoEnv& env, int t, int max_steps) {
 CatchRule::Config CatchRule::Config::read(const Section& e, const Vec3& hold_target) {
   Config c;
   c.hold_target = hold_target;
-  c.in_hand = e.get("in_hand", c.in_hand);
-  c.in_air = e.get("in_air", c.in_air);
-  c.on_ground = e.get("on_ground", c.on_ground);
+  c.in_hand = e.get("in_hand", c.in_hand, Range::positive());
+  c.in_air = e.get("in_air", c.in_air, Range::non_negative());
+  c.on_ground = e.get("on_ground", c.on_ground, Range::non_negative());
   c.start = read_vec3(e, "start", c.start);
-  c.quat_noise = e.get("quat_noise", c.quat_noise);
-  c.throw_force = e.get("throw_force", c.throw_force);
+  c.quat_noise = e.get("quat_noise", c.quat_noise, Range::non_negative());
+  c.throw_force = e.get("throw_force", c.throw_force, Range::non_negative());
   c.aim = read_vec3(e, "aim", c.aim);
-  c.aim_spread = e.get("aim_spread", c.aim_spread);
-  c.catch_bonus = e.get("catch_bonus", c.catch_bonus);
-  c.hold_weight = e.get("hold_weight", c.hold_weight);
+  c.aim_spread = e.get("aim_spread", c.aim_spread, Range::non_negative());
+  c.catch_bonus = e.get("catch_bonus", c.catch_bonus, Range::non_negative());
+  c.hold_weight = e.get("hold_weight", c.hold_weight, Range::non_negative());
   c.hold_target = read_vec3(e, "hold_target", c.hold_target);
-  c.hold_steps = e.get("hold_steps", c.hold_steps);
-  if (c.hold_steps < 1) throw e.error("hold_steps", "must be at least 1");
+  c.hold_steps = e.get("hold_steps", c.hold_steps, Range::at_least(1));
   return c;
 }
 
@@ -106,25 +104,25 @@ RuleStep CatchRule::step(const JacoEnv& env) {
 
 TossRule::Config TossRule::Config::read(const Section& e) {
   Config c;
-  c.in_hand = e.get("in_hand", c.in_hand);
-  c.in_air = e.get("in_air", c.in_air);
+  c.in_hand = e.get("in_hand", c.in_hand, Range::positive());
+  c.in_air = e.get("in_air", c.in_air, Range::non_negative());
   c.start = read_vec3(e, "start", c.start);
-  c.start_noise = e.get("start_noise", c.start_noise);
-  c.vel_noise = e.get("vel_noise", c.vel_noise);
-  c.guide_weight = e.get("guide_weight", c.guide_weight);
-  c.lift_weight = e.get("lift_weight", c.lift_weight);
-  c.release_height = e.get("release_height", c.release_height);
-  c.release_bonus = e.get("release_bonus", c.release_bonus);
-  c.stable_weight = e.get("stable_weight", c.stable_weight);
-  c.stable_slack = e.get("stable_slack", c.stable_slack);
-  c.land_x = e.get("land_x", c.land_x);
-  c.land_y = e.get("land_y", c.land_y);
-  c.apex_height = e.get("apex_height", c.apex_height);
-  c.apex_weight = e.get("apex_weight", c.apex_weight);
-  c.apex_tolerance = e.get("apex_tolerance", c.apex_tolerance);
-  c.apex_bonus = e.get("apex_bonus", c.apex_bonus);
-  c.land_tolerance = e.get("land_tolerance", c.land_tolerance);
-  c.success_bonus = e.get("success_bonus", c.success_bonus);
+  c.start_noise = e.get("start_noise", c.start_noise, Range::non_negative());
+  c.vel_noise = e.get("vel_noise", c.vel_noise, Range::non_negative());
+  c.guide_weight = e.get("guide_weight", c.guide_weight, Range::non_negative());
+  c.lift_weight = e.get("lift_weight", c.lift_weight, Range::non_negative());
+  c.release_height = e.get("release_height", c.release_height, Range::positive());
+  c.release_bonus = e.get("release_bonus", c.release_bonus, Range::non_negative());
+  c.stable_weight = e.get("stable_weight", c.stable_weight, Range::non_negative());
+  c.stable_slack = e.get("stable_slack", c.stable_slack, Range::non_negative());
+  c.land_x = e.get("land_x", c.land_x, Range::any());
+  c.land_y = e.get("land_y", c.land_y, Range::any());
+  c.apex_height = e.get("apex_height", c.apex_height, Range::positive());
+  c.apex_weight = e.get("apex_weight", c.apex_weight, Range::non_negative());
+  c.apex_tolerance = e.get("apex_tolerance", c.apex_tolerance, Range::positive());
+  c.apex_bonus = e.get("apex_bonus", c.apex_bonus, Range::non_negative());
+  c.land_tolerance = e.get("land_tolerance", c.land_tolerance, Range::positive());
+  c.success_bonus = e.get("success_bonus", c.success_bonus, Range::non_negative());
   if (!(c.apex_height > c.release_height)) throw e.error("apex_height", "must be above release_height");
   return c;
 }
@@ -194,22 +192,21 @@ RuleStep TossRule::step(const JacoEnv& env) {
 
 HitRule::Config HitRule::Config::read(const Section& e) {
   Config c;
-  c.hit_distance = e.get("hit_distance", c.hit_distance);
-  c.on_ground = e.get("on_ground", c.on_ground);
+  c.hit_distance = e.get("hit_distance", c.hit_distance, Range::positive());
+  c.on_ground = e.get("on_ground", c.on_ground, Range::non_negative());
   c.start = read_vec3(e, "start", c.start);
-  c.start_noise = e.get("start_noise", c.start_noise);
-  c.vel_noise = e.get("vel_noise", c.vel_noise);
-  c.hit_height = e.get("hit_height", c.hit_height);
-  c.hit_weight = e.get("hit_weight", c.hit_weight);
-  c.hit_tolerance = e.get("hit_tolerance", c.hit_tolerance);
-  c.hit_bonus = e.get("hit_bonus", c.hit_bonus);
-  c.vx_cost = e.get("vx_cost", c.vx_cost);
+  c.start_noise = e.get("start_noise", c.start_noise, Range::non_negative());
+  c.vel_noise = e.get("vel_noise", c.vel_noise, Range::non_negative());
+  c.hit_height = e.get("hit_height", c.hit_height, Range::positive());
+  c.hit_weight = e.get("hit_weight", c.hit_weight, Range::non_negative());
+  c.hit_tolerance = e.get("hit_tolerance", c.hit_tolerance, Range::positive());
+  c.hit_bonus = e.get("hit_bonus", c.hit_bonus, Range::non_negative());
+  c.vx_cost = e.get("vx_cost", c.vx_cost, Range::non_negative());
   c.target = read_vec3(e, "target", c.target);
-  c.target_radius = e.get("target_radius", c.target_radius);
-  c.target_bonus = e.get("target_bonus", c.target_bonus);
-  c.miss_weight = e.get("miss_weight", c.miss_weight);
-  c.approach_weight = e.get("approach_weight", c.approach_weight);
-  if (!(c.target_radius > 0)) throw e.error("target_radius", "must be positive");
+  c.target_radius = e.get("target_radius", c.target_radius, Range::positive());
+  c.target_bonus = e.get("target_bonus", c.target_bonus, Range::non_negative());
+  c.miss_weight = e.get("miss_weight", c.miss_weight, Range::non_negative());
+  c.approach_weight = e.get("approach_weight", c.approach_weight, Range::non_negative());
   return c;
 }
 

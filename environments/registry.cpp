@@ -35,45 +35,40 @@ Factory walker_jump(const std::string& name, const Section& env) {
   WalkerConfig w = WalkerConfig::read(env);
   ObstacleConfig o = ObstacleConfig::read(env);
   WalkerJump::Config j;
-  j.curb_x = env.get("curb_x", j.curb_x);
-  j.curb_noise = env.get("curb_noise", j.curb_noise);
-  j.cross_bonus = env.get("cross_bonus", j.cross_bonus);
-  j.upward_weight = env.get("upward_weight", j.upward_weight);
-  j.height_weight = env.get("height_weight", j.height_weight);
-  j.end_x = env.get("end_x", j.end_x);
-  j.curb_height = env.get("curb_height", j.curb_height);
-  j.curb_height_min = env.get("curb_height_min", j.curb_height);
-  if (j.curb_height_min > j.curb_height || j.curb_height_min <= 0)
-    throw env.error("curb_height_min", "must be in (0, curb_height]");
-  j.curbs = env.get("curbs", j.curbs);
-  j.curb_spacing = env.get("curb_spacing", j.curb_spacing);
-  j.clearance_weight = env.get("clearance_weight", j.clearance_weight);
-  j.clearance_before = env.get("clearance_before", j.clearance_before);
-  j.peak_weight = env.get("peak_weight", j.peak_weight);
+  j.curb_x = env.get("curb_x", j.curb_x, Range::any());
+  j.curb_noise = env.get("curb_noise", j.curb_noise, Range::non_negative());
+  j.cross_bonus = env.get("cross_bonus", j.cross_bonus, Range::non_negative());
+  j.upward_weight = env.get("upward_weight", j.upward_weight, Range::non_negative());
+  j.height_weight = env.get("height_weight", j.height_weight, Range::non_negative());
+  j.end_x = env.get("end_x", j.end_x, Range::any());
+  j.curb_height = env.get("curb_height", j.curb_height, Range::positive());
+  j.curb_height_min = env.get("curb_height_min", j.curb_height, Range::positive());
+  if (j.curb_height_min > j.curb_height) throw env.error("curb_height_min", "must be at most curb_height");
+  j.curbs = env.get("curbs", j.curbs, Range::at_least(1));
+  j.curb_spacing = env.get("curb_spacing", j.curb_spacing, Range::positive());
+  j.clearance_weight = env.get("clearance_weight", j.clearance_weight, Range::non_negative());
+  j.clearance_before = env.get("clearance_before", j.clearance_before, Range::non_negative());
+  j.peak_weight = env.get("peak_weight", j.peak_weight, Range::non_negative());
   j.contact_ends = env.get("contact_ends", j.contact_ends);
-  j.mark_upward_weight = env.get("mark_upward_weight", j.mark_upward_weight);
+  j.mark_upward_weight = env.get("mark_upward_weight", j.mark_upward_weight, Range::non_negative());
   j.ghost_curbs = env.get("ghost_curbs", j.ghost_curbs);
-  j.ghost_depth_cost = env.get("ghost_depth_cost", j.ghost_depth_cost);
-  j.takeoff_bonus = env.get("takeoff_bonus", j.takeoff_bonus);
-  j.close_stance_cost = env.get("close_stance_cost", j.close_stance_cost);
-  j.stance_height = env.get("stance_height", j.stance_height);
-  j.placement_bonus = env.get("placement_bonus", j.placement_bonus);
-  j.placement_target = env.get("placement_target", j.placement_target);
-  j.placement_width = env.get("placement_width", j.placement_width);
-  if (j.placement_width <= 0) throw env.error("placement_width", "must be positive");
-  j.approach_speed = env.get("approach_speed", j.approach_speed);
-  j.approach_from = env.get("approach_from", j.approach_from);
-  j.approach_to = env.get("approach_to", j.approach_to);
-  if (j.approach_speed < 0) throw env.error("approach_speed", "must be >= 0 (0: off)");
-  if (!(j.approach_to >= 0 && j.approach_to < j.approach_from))
-    throw env.error("approach_to", "must be in [0, approach_from)");
+  j.ghost_depth_cost = env.get("ghost_depth_cost", j.ghost_depth_cost, Range::non_negative());
+  j.takeoff_bonus = env.get("takeoff_bonus", j.takeoff_bonus, Range::non_negative());
+  j.close_stance_cost = env.get("close_stance_cost", j.close_stance_cost, Range::non_negative());
+  j.stance_height = env.get("stance_height", j.stance_height, Range::non_negative());
+  j.placement_bonus = env.get("placement_bonus", j.placement_bonus, Range::non_negative());
+  j.placement_target = env.get("placement_target", j.placement_target, Range::any());
+  j.placement_width = env.get("placement_width", j.placement_width, Range::positive());
+  j.approach_speed = env.get("approach_speed", j.approach_speed, Range::non_negative());
+  j.approach_from = env.get("approach_from", j.approach_from, Range::positive());
+  j.approach_to = env.get("approach_to", j.approach_to, Range::non_negative());
+  if (!(j.approach_to < j.approach_from)) throw env.error("approach_to", "must be below approach_from");
   if (env.has("takeoff_zone")) {
-    const auto zone = env.get("takeoff_zone", std::vector<double>());
-    if (zone.size() != 2 || !(zone[0] < zone[1]) || zone[1] > 0)
+    const auto zone = env.get("takeoff_zone", std::vector<double>(), Range::at_most(0));
+    if (zone.size() != 2 || !(zone[0] < zone[1]))
       throw env.error("takeoff_zone", "must be [low, high] with low < high <= 0 (metres before the curb)");
     j.takeoff_zone = {zone[0], zone[1]};
   }
-  if (j.curbs < 1) throw env.error("curbs", "must be at least 1");
   if (j.curbs > 1 && j.curb_spacing <= 2 * j.curb_noise + o.curb_width)
     throw env.error("curb_spacing", "must exceed 2 curb_noise + curb_width so curbs do not overlap");
   return [=] { return std::make_unique<WalkerJump>(name, w, o, j); };
@@ -85,10 +80,11 @@ Factory walker_crawl(const std::string& name, const Section& env) {
   WalkerConfig w = WalkerConfig::read(env, defaults);
   ObstacleConfig o = ObstacleConfig::read(env);
   WalkerCrawl::Config c;
-  c.ceiling_start = env.get("ceiling_start", c.ceiling_start);
-  c.ceiling_end = env.get("ceiling_end", c.ceiling_end);
-  c.crouch_weight = env.get("crouch_weight", c.crouch_weight);
-  c.crouch_height = env.get("crouch_height", c.crouch_height);
+  c.ceiling_start = env.get("ceiling_start", c.ceiling_start, Range::any());
+  c.ceiling_end = env.get("ceiling_end", c.ceiling_end, Range::any());
+  c.crouch_weight = env.get("crouch_weight", c.crouch_weight, Range::non_negative());
+  c.crouch_height = env.get("crouch_height", c.crouch_height, Range::positive());
+  if (!(c.ceiling_start < c.ceiling_end)) throw env.error("ceiling_end", "must be beyond ceiling_start");
   return [=] { return std::make_unique<WalkerCrawl>(name, w, o, c); };
 }
 
@@ -108,13 +104,13 @@ Builder walker_course(WalkerCourse::Config defaults, int max_steps) {
     WalkerConfig w = WalkerConfig::read(env, wd);
     ObstacleConfig o = ObstacleConfig::read(env);
     WalkerCourse::Config c = defaults;
-    c.positions = env.get("positions", c.positions);
-    c.position_noise = env.get("position_noise", c.position_noise);
+    c.positions = env.get("positions", c.positions, Range::any());
+    c.position_noise = env.get("position_noise", c.position_noise, Range::non_negative());
     c.kinds = env.get("kinds", c.kinds);
     c.shuffle = env.get("shuffle", c.shuffle);
-    c.pass_bonus = env.get("pass_bonus", c.pass_bonus);
-    c.ceiling_zone = env.get("ceiling_zone", c.ceiling_zone);
-    c.ceiling_fall_height = env.get("ceiling_fall_height", c.ceiling_fall_height);
+    c.pass_bonus = env.get("pass_bonus", c.pass_bonus, Range::non_negative());
+    c.ceiling_zone = env.get("ceiling_zone", c.ceiling_zone, Range::non_negative());
+    c.ceiling_fall_height = env.get("ceiling_fall_height", c.ceiling_fall_height, Range::non_negative());
     if (c.kinds.size() != c.positions.size())
       throw env.error("kinds", "needs one entry per position (" + std::to_string(c.positions.size()) + ")");
     for (const auto& k : c.kinds)
@@ -141,9 +137,9 @@ WalkerCourse::Config obstacle_course_layout() {
 Factory walker_patrol(const std::string& name, const Section& env) {
   WalkerConfig w = WalkerConfig::read(env, composite_defaults(10000));
   WalkerPatrol::Config c;
-  c.stone_x = env.get("stone_x", c.stone_x);
-  c.max_turns = env.get("max_turns", c.max_turns);
-  c.turn_bonus = env.get("turn_bonus", c.turn_bonus);
+  c.stone_x = env.get("stone_x", c.stone_x, Range::positive());
+  c.max_turns = env.get("max_turns", c.max_turns, Range::at_least(1));
+  c.turn_bonus = env.get("turn_bonus", c.turn_bonus, Range::non_negative());
   return [=] { return std::make_unique<WalkerPatrol>(name, w, c); };
 }
 
@@ -171,17 +167,14 @@ JacoConfig jaco_composite(const Section& env, int max_steps, int random_steps = 
 }
 
 int read_successes(const Section& env) {
-  const int n = env.get("successes", 5);
-  if (n < 1) throw env.error("successes", "must be at least 1");
-  return n;
+  return env.get("successes", 5, Range::at_least(1));
 }
 
 Factory repetitive_picking(const std::string& name, const Section& env) {
   JacoConfig c = jaco_composite(env, 1000);
   JacoRepetitivePick::Config k;
   k.successes = read_successes(env);
-  k.pick_steps = env.get("pick_steps", k.pick_steps);
-  if (k.pick_steps < 1) throw env.error("pick_steps", "must be at least 1");
+  k.pick_steps = env.get("pick_steps", k.pick_steps, Range::at_least(1));
   k.pick = PickRule::Config::read(env);
   return [=] { return std::make_unique<JacoRepetitivePick>(name, c, k); };
 }
@@ -191,10 +184,8 @@ Factory repetitive_catching(const std::string& name, const Section& env) {
   JacoConfig c = jaco_composite(env, 1000, 10);
   JacoRepetitiveCatch::Config k;
   k.successes = read_successes(env);
-  k.pin_steps = env.get("pin_steps", k.pin_steps);
-  k.fall_steps = env.get("fall_steps", k.fall_steps);
-  if (k.pin_steps < 0) throw env.error("pin_steps", "must be >= 0");
-  if (k.fall_steps < 0) throw env.error("fall_steps", "must be >= 0");
+  k.pin_steps = env.get("pin_steps", k.pin_steps, Range::non_negative());
+  k.fall_steps = env.get("fall_steps", k.fall_steps, Range::non_negative());
   k.catching = CatchRule::Config::read(env, /*hold_target=*/{0.0, 0.2, 0.2});  // KeepCatch's, not Catch's
   return [=] { return std::make_unique<JacoRepetitiveCatch>(name, c, k); };
 }
@@ -203,9 +194,9 @@ Factory repetitive_catching(const std::string& name, const Section& env) {
 Factory serve(const std::string& name, const Section& env) {
   JacoConfig c = jaco_composite(env, 300);
   JacoServe::Config k;
-  k.judge_height = env.get("judge_height", k.judge_height);
-  k.toss_bonus = env.get("toss_bonus", k.toss_bonus);
-  k.toss_tolerance = env.get("toss_tolerance", k.toss_tolerance);
+  k.judge_height = env.get("judge_height", k.judge_height, Range::non_negative());
+  k.toss_bonus = env.get("toss_bonus", k.toss_bonus, Range::non_negative());
+  k.toss_tolerance = env.get("toss_tolerance", k.toss_tolerance, Range::non_negative());
   k.toss = TossRule::Config::read(env);
   k.hit = HitRule::Config::read(env);
   return [=] { return std::make_unique<JacoServe>(name, c, k); };
@@ -243,6 +234,22 @@ Factory task_factory(const std::string& task, const Section& env) {
     throw Error("unknown task '" + task + "' (known: " + known + ")");
   }
   return it->second(task, env);
+}
+
+Factory read_task(const Section& root, const std::string& task) {
+  Factory make;
+  try {
+    make = task_factory(task, root.sub("env"));
+  } catch (const Error& e) {
+    if (std::string(e.what()).rfind("unknown task", 0) == 0) throw root.error("task", e.what());
+    throw;
+  }
+  try {
+    make();
+  } catch (const Error& e) {
+    throw root.error("env", e.what());
+  }
+  return make;
 }
 
 std::vector<std::string> task_names() {

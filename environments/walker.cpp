@@ -6,21 +6,19 @@
 namespace segue {
 
 WalkerConfig WalkerConfig::read(const Section& s, WalkerConfig c) {
-  c.max_episode_steps = s.get("max_episode_steps", c.max_episode_steps);
-  c.success_steps = s.get("success_steps", c.success_steps);
-  c.init_noise = s.get("init_noise", c.init_noise);
-  c.init_random_steps = s.get("init_random_steps", c.init_random_steps);
-  c.push_prob = s.get("push_prob", c.push_prob);
-  c.push_force = s.get("push_force", c.push_force);
-  c.fall_height = s.get("fall_height", c.fall_height);
-  c.target_speed = s.get("target_speed", c.target_speed);
-  c.height_target = s.get("height_target", c.height_target);
-  c.upright_weight = s.get("upright_weight", c.upright_weight);
-  c.alive_bonus = s.get("alive_bonus", c.alive_bonus);
-  c.foot_cost = s.get("foot_cost", c.foot_cost);
-  c.ctrl_cost = s.get("ctrl_cost", c.ctrl_cost);
-  if (c.max_episode_steps <= 0) throw s.error("max_episode_steps", "must be positive");
-  if (c.push_prob < 0 || c.push_prob > 1) throw s.error("push_prob", "must be in [0, 1]");
+  c.max_episode_steps = s.get("max_episode_steps", c.max_episode_steps, Range::positive());
+  c.success_steps = s.get("success_steps", c.success_steps, Range::positive());
+  c.init_noise = s.get("init_noise", c.init_noise, Range::non_negative());
+  c.init_random_steps = s.get("init_random_steps", c.init_random_steps, Range::non_negative());
+  c.push_prob = s.get("push_prob", c.push_prob, Range::closed(0, 1));
+  c.push_force = s.get("push_force", c.push_force, Range::non_negative());
+  c.fall_height = s.get("fall_height", c.fall_height, Range::non_negative());
+  c.target_speed = s.get("target_speed", c.target_speed, Range::non_negative());
+  c.height_target = s.get("height_target", c.height_target, Range::positive());
+  c.upright_weight = s.get("upright_weight", c.upright_weight, Range::non_negative());
+  c.alive_bonus = s.get("alive_bonus", c.alive_bonus, Range::non_negative());
+  c.foot_cost = s.get("foot_cost", c.foot_cost, Range::non_negative());
+  c.ctrl_cost = s.get("ctrl_cost", c.ctrl_cost, Range::non_negative());
   return c;
 }
 

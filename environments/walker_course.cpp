@@ -10,6 +10,8 @@ WalkerCourse::WalkerCourse(const std::string& name, const WalkerConfig& w, const
     : WalkerObstacleEnv(name, w, o, true), ccfg_(c) {
   spec_.feature_names = {"curb_ahead", "curb_behind", "ceiling_ahead", "ceiling_behind", "steps", "distance"};
   for (const auto& k : c.kinds) kinds_.push_back(k == "curb" ? ObstacleKind::Curb : ObstacleKind::Ceiling);
+  const auto curbs = size_t(std::count(kinds_.begin(), kinds_.end(), ObstacleKind::Curb));
+  require_obstacles(curbs, kinds_.size() - curbs, "kinds");
 }
 
 void WalkerCourse::reset_task() {

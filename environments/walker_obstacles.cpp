@@ -20,14 +20,14 @@ double capsule_depth_in_box(const std::array<double, 2>& p0, const std::array<do
 }
 
 ObstacleConfig ObstacleConfig::read(const Section& s, ObstacleConfig c) {
-  c.detect_distance = s.get("detect_distance", c.detect_distance);
-  c.curb_far_start = s.get("curb_far_start", c.curb_far_start);
-  c.curb_far_end = s.get("curb_far_end", c.curb_far_end);
-  c.ceiling_far_start = s.get("ceiling_far_start", c.ceiling_far_start);
-  c.ceiling_far_end = s.get("ceiling_far_end", c.ceiling_far_end);
-  c.pass_margin = s.get("pass_margin", c.pass_margin);
-  c.contact_penalty = s.get("contact_penalty", c.contact_penalty);
-  c.ceiling_length = s.get("ceiling_length", c.ceiling_length);
+  c.detect_distance = s.get("detect_distance", c.detect_distance, Range::positive());
+  c.curb_far_start = s.get("curb_far_start", c.curb_far_start, Range::non_negative());
+  c.curb_far_end = s.get("curb_far_end", c.curb_far_end, Range::non_negative());
+  c.ceiling_far_start = s.get("ceiling_far_start", c.ceiling_far_start, Range::non_negative());
+  c.ceiling_far_end = s.get("ceiling_far_end", c.ceiling_far_end, Range::non_negative());
+  c.pass_margin = s.get("pass_margin", c.pass_margin, Range::non_negative());
+  c.contact_penalty = s.get("contact_penalty", c.contact_penalty, Range::non_negative());
+  c.ceiling_length = s.get("ceiling_length", c.ceiling_length, Range::positive());
   return c;
 }
 
@@ -45,6 +45,13 @@ WalkerObstacleEnv::WalkerObstacleEnv(const std::string& name, const WalkerConfig
   }
   parked_pos_.assign(model_->geom_pos, model_->geom_pos + 3 * model_->ngeom);
   parked_size_.assign(model_->geom_size, model_->geom_size + 3 * model_->ngeom);
+}
+
+void WalkerObstacleEnv::require_obstacles(size_t curbs, size_t ceilings, const std::string& key) const {
+  if (curbs > curb_geoms_.size() || ceilings > ceiling_geoms_.size())
+    throw Error(spec_.name + ": env." + key + " asks for " + std::to_string(curbs) + " curbs and " +
+                std::to_string(ceilings) + " ceilings; the model (assets/walker/walker_obstacles.xml) holds " +
+                std::to_string(curb_geoms_.size()) + " and " + std::to_string(ceiling_geoms_.size()));
 }
 
 void WalkerObstacleEnv::set_obstacles(const std::vector<Obstacle>& layout) {
@@ -173,6 +180,7 @@ void WalkerObstacleEnv::restore_task_state(const double* in, size_t n) {
 WalkerJump::WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c)
     : WalkerObstacleEnv(name, w, o, true), jcfg_(c) {
   spec_.feature_names = {"curb_ahead", "curb_behind"};
+  require_obstacles(size_t(jcfg_.curbs), 0, "curbs");
   if (jcfg_.ghost_curbs) make_curbs_ghosts();
   for (int g = 0; g < model_->ngeom; ++g)
     if (model_->geom_bodyid[g] != 0 && model_->geom_type[g] == mjGEOM_CAPSULE) walker_capsules_.push_back(g);

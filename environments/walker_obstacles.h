@@ -61,6 +61,8 @@ class WalkerObstacleEnv : public WalkerEnv {
  protected:
   // Moves the model's obstacle geoms to this layout; unused ones are parked.
   void set_obstacles(const std::vector<Obstacle>& layout);
+  // Refuses, when the task is built, a layout that needs more obstacles than the model holds.
+  void require_obstacles(size_t curbs, size_t ceilings, const std::string& key) const;
   // Resizes the index-th curb of the layout to this height (it stands on the floor).
   void set_curb_height(size_t index, double height);
   // Curbs stop colliding: the walker passes through them (a training curriculum).

@@ -18,12 +18,7 @@ CompositeRecipe CompositeRecipe::load(const std::string& file, const std::vector
   CompositeRecipe c;
   c.file = file;
   c.task = root.require<std::string>("task");
-  try {
-    c.make_env = task_factory(c.task, root.sub("env"));
-  } catch (const Error& e) {
-    if (std::string(e.what()).rfind("unknown task", 0) == 0) throw root.error("task", e.what());
-    throw;
-  }
+  c.make_env = read_task(root, c.task);
   c.spec = c.make_env()->spec();
   c.skills = read_skills(root.sub("skills"), c.spec);
   c.meta = MetaController(root, c.skills, c.spec.feature_names,
@@ -67,13 +62,13 @@ CompositeRecipe CompositeRecipe::load(const std::string& file, const std::vector
       }
     }
   Section ev = root.sub("eval");
-  c.eval_episodes = ev.get("episodes", c.eval_episodes);
-  c.eval_seeds = ev.get("seeds", c.eval_seeds);
-  if (c.eval_episodes <= 0) throw ev.error("episodes", "must be positive");
+  c.eval_episodes = ev.get("episodes", c.eval_episodes, Range::positive());
+  c.eval_seeds = ev.get("seeds", c.eval_seeds, Range::non_negative());
   if (c.eval_seeds.empty()) throw ev.error("seeds", "lists no seed");
   recipe.reject_unknown();
   c.resolved = recipe.resolved_yaml();
   c.defaulted = recipe.defaulted_keys();
+  c.key_rules = recipe.key_rules();
   return c;
 }
 
@@ -144,16 +139,24 @@ ControllerFactory method_controllers(const CompositeRecipe& r, const std::string
     std::string path = repo_path(r.single_policy);
     if (!std::filesystem::exists(path))
       throw Error(r.file + ": key 'methods.single.policy': no such policy file '" + r.single_policy + "'");
-    Policy p = Policy::load(path);
-    p.check_fits(r.spec, path);
-    return [p] { return std::make_unique<PolicyController>(p); };
+    try {
+      Policy p = Policy::load(path);
+      p.check_fits(r.spec, path);
+      return [p] { return std::make_unique<PolicyController>(p); };
+    } catch (const Error& e) {
+      throw Error(r.file + ": key 'methods.single.policy': " + e.what());
+    }
   }
   if (method == "tp" || method == "tp+q" || method == "lee") {
     if (r.transitions_dir.empty())
       throw Error(r.file + ": key 'methods.transitions' is not set (a folder of trained transition policies)");
     const std::string file = method == "lee" ? "lee.pt" : "policy.pt";
-    std::vector<TransitionArtefacts> artefacts =
-        load_transition_artefacts(r, repo_path(r.transitions_dir), file, /*with_q=*/method == "tp+q");
+    std::vector<TransitionArtefacts> artefacts;
+    try {
+      artefacts = load_transition_artefacts(r, repo_path(r.transitions_dir), file, /*with_q=*/method == "tp+q");
+    } catch (const Error& e) {
+      throw Error(r.file + ": key 'methods.transitions': " + e.what());
+    }
     for (size_t t = 0; t < artefacts.size(); ++t) {
       auto missing = [&](const std::string& f) {
         return Error(r.file + ": key 'methods.transitions': no " + f + " for transition " +

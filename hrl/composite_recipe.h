@@ -41,6 +41,7 @@ struct CompositeRecipe {
   PipelineConfig pipeline;
   std::string resolved;         // the recipe as read, defaults included (for run dirs)
   std::set<std::string> defaulted;  // its keys left at their defaults
+  std::map<std::string, KeyRule> key_rules;  // each key's type and range (segue keys)
   int eval_episodes = 50;
   std::vector<int> eval_seeds{0, 1, 2};
 

@@ -19,8 +19,7 @@ LeadIn LeadIn::read(const Section& s, const EnvSpec& task) {
   }
   l.when = read_when(s, task.feature_names);
   if (l.when.empty()) throw s.error("when", "give the interval the lead-in hands over in, e.g. {curb_ahead: [3, 4]}");
-  l.share = s.get("share", l.share);
-  if (!(l.share > 0 && l.share <= 1)) throw s.error("share", "must be in (0, 1]");
+  l.share = s.get("share", l.share, Range::open_closed(0, 1));
   return l;
 }
 

@@ -29,8 +29,8 @@ std::vector<Condition> read_when(const Section& s, const std::vector<std::string
       for (const auto& f : features) known += (known.empty() ? "" : ", ") + f;
       throw w.error(name, "the task has no feature '" + name + "' (features: " + known + ")");
     }
-    std::vector<double> range = w.is_sequence(name) ? w.require<std::vector<double>>(name)
-                                                    : std::vector<double>(2, w.require<double>(name));
+    std::vector<double> range = w.is_sequence(name) ? w.require<std::vector<double>>(name, Range::any())
+                                                    : std::vector<double>(2, w.require<double>(name, Range::any()));
     if (range.size() != 2 || range[0] > range[1]) throw w.error(name, "expects [lo, hi] with lo <= hi");
     when.push_back({int(it - features.begin()), range[0], range[1]});
   }
@@ -48,16 +48,17 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
     tr.from = find_skill(t, "from", skills);
     tr.to = find_skill(t, "to", skills);
     tr.when = tr.expert_when = read_when(t, features);
-    tr.start_states = t.get<int>("start_states", 0);
-    if (t.has("start_states") && tr.start_states <= 0) throw t.error("start_states", "must be positive");
-    tr.max_steps = t.get<int>("max_steps", 0);
-    if (t.has("max_steps") && tr.max_steps <= 0) throw t.error("max_steps", "must be positive");
+    // 0 stands for an absent key (the pipeline's collect.start_states; no cap), not a value.
+    tr.start_states = t.get<int>("start_states", 0, Range::non_negative());
+    if (t.has("start_states") && tr.start_states == 0) throw t.error("start_states", "must be positive");
+    tr.max_steps = t.get<int>("max_steps", 0, Range::non_negative());
+    if (t.has("max_steps") && tr.max_steps == 0) throw t.error("max_steps", "must be positive");
     if (t.has("training")) {
       Section w = t.sub("training");
       if (!w.has("when") && !w.has("max_steps")) throw t.error("training", "give its window: when and/or max_steps");
       if (w.has("when")) tr.training_when = read_when(w, features);
-      tr.training_max_steps = w.get<int>("max_steps", 0);
-      if (w.has("max_steps") && tr.training_max_steps <= 0) throw w.error("max_steps", "must be positive");
+      tr.training_max_steps = w.get<int>("max_steps", 0, Range::non_negative());
+      if (w.has("max_steps") && tr.training_max_steps == 0) throw w.error("max_steps", "must be positive");
     } else {
       tr.training_when = tr.when, tr.training_max_steps = tr.max_steps;
     }
@@ -79,8 +80,8 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
           throw e.error("task", err.what());
         }
         tr.expert_when = read_when(e, own);
-        tr.expert_steps = e.get<int>("steps", 0);
-        if (e.has("steps") && tr.expert_steps <= 0) throw e.error("steps", "must be positive");
+        tr.expert_steps = e.get<int>("steps", 0, Range::non_negative());
+        if (e.has("steps") && tr.expert_steps == 0) throw e.error("steps", "must be positive");
       }
     }
     for (const Transition& other : transitions_)

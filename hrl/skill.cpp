@@ -21,7 +21,7 @@ std::vector<Skill> read_skills(const Section& section, const EnvSpec& task) {
     } catch (const Error& e) {
       throw s.error("policy", e.what());
     }
-    std::vector<int> slice = s.get("obs", std::vector<int>{0, k.policy.obs_dim()});
+    std::vector<int> slice = s.get("obs", std::vector<int>{0, k.policy.obs_dim()}, Range::non_negative());
     if (slice.size() != 2 || slice[0] < 0 || slice[1] > task.obs_dim || slice[1] - slice[0] != k.policy.obs_dim())
       throw s.error("obs", "policy '" + file + "' takes " + std::to_string(k.policy.obs_dim()) +
                                " observation numbers; the slice must be [begin, end) within task '" +

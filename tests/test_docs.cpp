@@ -4,6 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "core/run_dir.h"
 #include "tests/cli_run.h"
@@ -17,6 +20,19 @@ TEST(Docs, RecipeReferenceIsTheLoadersOutput) {
       << "docs/recipes.md is stale: regenerate it with `build/segue keys > docs/recipes.md`";
   for (const char* key : {"`ppo.lr`", "`env.throw_force`", "`switch.attempts`", "`lead_in.share`"})
     EXPECT_NE(keys.output.find(key), std::string::npos) << key;
+  // Every number a recipe may hold declares the values it accepts (where it is read).
+  std::istringstream rows(keys.output);
+  int numbers = 0;
+  for (std::string row; std::getline(rows, row);) {
+    std::vector<std::string> cells;
+    std::istringstream in(row);
+    for (std::string cell; std::getline(in, cell, '|');) cells.push_back(cell);
+    if (cells.size() != 5 || cells[1].find('`') == std::string::npos) continue;  // not a key's row
+    if (cells[2].find("number") == std::string::npos && cells[2].find("integer") == std::string::npos) continue;
+    ++numbers;
+    EXPECT_NE(cells[3], " ") << "no range declared for" << cells[1];
+  }
+  EXPECT_GT(numbers, 200);
 }
 
 TEST(Docs, EveryShippedRecipeLoadsAndValidates) {

@@ -115,7 +115,7 @@ TEST(LeadIn, RefusesWhatCannotLeadIn) {
   EXPECT_EQ(message("{policy: " + walk + "}"),
             "lead.yaml: key 'lead_in.when': give the interval the lead-in hands over in, e.g. {curb_ahead: [3, 4]}");
   EXPECT_EQ(message("{policy: " + walk + ", when: {curb_ahead: [3, 4]}, share: 0}"),
-            "lead.yaml: key 'lead_in.share': must be in (0, 1]");
+            "lead.yaml: key 'lead_in.share' must be in (0, 1], got 0");
   // The jump's policy sees 28 numbers: it cannot lead into the 26 of walker_forward.
   Recipe wide = Recipe::parse("lead_in: {policy: assets/policies/walker/walker_jump.pt, when: {steps: 1}}", "w.yaml");
   try {

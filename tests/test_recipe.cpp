@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -62,6 +63,40 @@ TEST(Recipe, IntegersOutOfTheirRangeAreRefused) {
   EXPECT_EQ(ppo.get<int>("seed", 0), 2000000);
 }
 
+TEST(Recipe, RangesAreCheckedWhereAKeyIsReadAndListed) {
+  EXPECT_EQ(Range::positive().text(), "> 0");
+  EXPECT_EQ(Range::non_negative().text(), ">= 0");
+  EXPECT_EQ(Range::open_closed(0, 1).text(), "in (0, 1]");
+  EXPECT_EQ(Range::closed_open(-1.5, 2).text(), "in [-1.5, 2)");
+  EXPECT_EQ(Range::at_most(0).text(), "<= 0");
+  EXPECT_EQ(Range::any().text(), "any");
+  EXPECT_TRUE(Range::open_closed(0, 1).contains(1));
+  EXPECT_FALSE(Range::open_closed(0, 1).contains(0));
+  EXPECT_FALSE(Range::closed_open(0, 1).contains(1));
+  Recipe r = Recipe::parse("a: -0.2\nb: [3, 0]\nc: 0.5\nd: relu\n", "r.yaml");
+  auto message = [](const auto& read) {
+    try {
+      read();
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(message([&] { r.root().get("a", 1.0, Range::positive()); }), "r.yaml: key 'a' must be > 0, got -0.2");
+  EXPECT_EQ(message([&] { r.root().get("b", std::vector<int>{}, Range::at_least(1)); }),
+            "r.yaml: key 'b' must hold numbers >= 1, got 0");
+  EXPECT_EQ(r.root().get("c", 1.0, Range::open_closed(0, 1)), 0.5);
+  EXPECT_EQ(message([&] { r.root().choice("d", "tanh", {"tanh", "elu"}); }),
+            "r.yaml: key 'd' must be one of tanh, elu, got 'relu'");
+  // A default is the code's own: NaN may stand for "not set" outside any range.
+  EXPECT_TRUE(std::isnan(r.root().get("e", double(NAN), Range::any())));
+  const auto& rules = r.key_rules();
+  EXPECT_EQ(rules.at("c").type, "a number");
+  EXPECT_EQ(rules.at("c").accepts, "in (0, 1]");
+  EXPECT_EQ(rules.at("e").accepts, "any");
+  EXPECT_EQ(rules.at("d").accepts, "one of tanh, elu");
+}
+
 TEST(Recipe, WrongTypeAndMalformedYaml) {
   Recipe r = Recipe::parse("ppo: {epochs: many, lr: [1, 2]}\n", "r.yaml");
   try {
@@ -113,7 +148,7 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run("train " + (dir_ / "missing.yaml").string()), "missing.yaml: cannot read recipe");
   auto ok = write("ok.yaml", "task: walker_forward\n");
   expect_one_line_error(run("train " + ok + " --set ppo.lrr=1"), "unknown key 'ppo.lrr' (from --set)");
-  expect_one_line_error(run("train " + ok + " --set ppo.noise_repeat=0"), "key 'ppo.noise_repeat': must be positive");
+  expect_one_line_error(run("train " + ok + " --set ppo.noise_repeat=0"), "key 'ppo.noise_repeat' must be > 0, got 0");
   auto zone = write("zone.yaml", "task: walker_jump\nenv: {takeoff_zone: [-0.6, -1.2]}\n");
   expect_one_line_error(run("train " + zone), "zone.yaml: key 'env.takeoff_zone': must be [low, high] with low < high <= 0");
   auto std_alone = write("std.yaml", "task: walker_forward\ninit_log_std: -1\n");
@@ -125,7 +160,7 @@ TEST_F(CliErrors, BadRecipes) {
   const std::string in_tmp = "run_dir: " + (dir_ / "start_run").string() + "\n";
   auto nowhere = write("nowhere.yaml", "task: walker_jump\ninit_policy: nowhere.pt\n" + in_tmp);
   expect_one_line_error(run("train " + nowhere), "nowhere.yaml: key 'init_policy': no such policy 'nowhere.pt'");
-  std::filesystem::remove_all(dir_ / "start_run");  // the refused run's folder, recipe and all
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "start_run")) << "a refused start left its run directory";
   auto wider = write("wider.yaml", "task: walker_forward\ninit_policy: assets/policies/walker/walker_jump.pt\n" + in_tmp);
   expect_one_line_error(run("train " + wider), "key 'init_policy': 'assets/policies/walker/walker_jump.pt': policy takes obs_dim 28");
   auto ignore = write("ignore.yaml", "task: walker_forward\npolicy: {ignore_obs: [17, 30]}\n");
@@ -133,13 +168,13 @@ TEST_F(CliErrors, BadRecipes) {
   auto fourier = write("fourier.yaml", "task: walker_jump\npolicy: {fourier: {inputs: [28], periods: [1.9]}}\n");
   expect_one_line_error(run("train " + fourier), "key 'policy.fourier.inputs': must be observation indices in [0, 28)");
   auto period = write("period.yaml", "task: walker_jump\npolicy: {fourier: {inputs: [26], periods: [0]}}\n");
-  expect_one_line_error(run("train " + period), "key 'policy.fourier.periods': must be positive");
+  expect_one_line_error(run("train " + period), "key 'policy.fourier.periods' must hold numbers > 0, got 0");
   auto es_alone = write("es.yaml", "task: walker_jump\nes: {pairs: 4}\n");
   expect_one_line_error(run("train " + es_alone), "es.yaml: key 'es': fine-tunes a trained policy: give init_policy too");
   auto es_ppo = write("es_ppo.yaml", "task: walker_jump\ninit_policy: p.pt\nes: {pairs: 4}\nppo: {lr: 0.1}\n");
   expect_one_line_error(run("train " + es_ppo), "key 'ppo': does not apply to an evolution-strategy run (key 'es')");
-  expect_one_line_error(run("train " + es_alone + " --set es.sigma=0"), "key 'es.sigma': must be positive");
-  expect_one_line_error(run("train " + es_alone + " --set es.fitness=speed"), "key 'es.fitness': must be 'success' or 'return'");
+  expect_one_line_error(run("train " + es_alone + " --set es.sigma=0"), "key 'es.sigma' must be > 0, got 0");
+  expect_one_line_error(run("train " + es_alone + " --set es.fitness=speed"), "key 'es.fitness' must be one of success, return, got 'speed'");
   expect_one_line_error(run("train " + es_alone + " --set 'es.inputs=[28, 26]'"), "key 'es.inputs': must be [begin, end)");
   auto lead = write("lead.yaml", "task: walker_jump\nlead_in: {policy: nowhere.pt, when: {curb_ahead: [3, 4]}}\n");
   expect_one_line_error(run("train " + lead), "lead.yaml: key 'lead_in.policy': no such policy 'nowhere.pt'");
@@ -163,15 +198,15 @@ TEST_F(CliErrors, BadRecipes) {
   auto how = write("how.yaml", "task: walker_forward\nstages:\n  - {name: a}\n  - {name: b, continue: weights}\n");
   expect_one_line_error(run("train " + how), "key 'stages.1.continue' must be 'checkpoint' or 'policy'");
   auto curbs = write("curbs.yaml", "task: walker_jump\nenv: {curbs: 0}\n");
-  expect_one_line_error(run("train " + curbs), "key 'env.curbs': must be at least 1");
+  expect_one_line_error(run("train " + curbs), "key 'env.curbs' must be >= 1, got 0");
   // A composite recipe's transition and switch keys are checked when it is read.
   const std::string patrol = "eval --task patrol --method tp --episodes 1 --recipe " + std::string(SEGUE_SOURCE_DIR) +
                              "/experiments/patrol.yaml --set ";
-  expect_one_line_error(run(patrol + "switch.validation_starts=-1"), "key 'switch.validation_starts': must be >= 0");
+  expect_one_line_error(run(patrol + "switch.validation_starts=-1"), "key 'switch.validation_starts' must be >= 0, got -1");
   expect_one_line_error(run(patrol + "'switch.margins=[]'"), "key 'switch.margins': lists no margin");
-  expect_one_line_error(run(patrol + "switch.gamma=1.5"), "key 'switch.gamma': must be in (0, 1]");
+  expect_one_line_error(run(patrol + "switch.gamma=1.5"), "key 'switch.gamma' must be in (0, 1], got 1.5");
   expect_one_line_error(run(patrol + "transition.discriminator.gradient_penalty=-1"),
-                        "key 'transition.discriminator.gradient_penalty': must be >= 0");
+                        "key 'transition.discriminator.gradient_penalty' must be >= 0, got -1");
   expect_one_line_error(run(patrol + "transitions.0.max_steps=0"), "key 'transitions.0.max_steps': must be positive");
 }
 
@@ -186,17 +221,33 @@ TEST_F(CliErrors, NonsenseRefusedBeforeWork) {
   auto twice = write("dup.yaml", "task: walker_forward\nppo: {lr: 0.1}\nppo: {lr: 0.2}\n");
   expect_one_line_error(run("train " + twice), "dup.yaml: key 'ppo' is given twice");
   expect_one_line_error(run("train " + ok + " --set 'policy.pi_hidden=[32, 0]'"),
-                        "key 'policy.pi_hidden': layer widths must be positive, got 0");
-  expect_one_line_error(run("train " + ok + " --set ppo.total_steps=0"), "key 'ppo.total_steps': must be positive, got 0");
-  expect_one_line_error(run("train " + ok + " --set ppo.num_envs=100000000"), "key 'ppo.num_envs': must be in [1, 4096]");
-  expect_one_line_error(run("train " + ok + " --set ppo.clip=-0.2"), "key 'ppo.clip': must be > 0");
+                        "key 'policy.pi_hidden' must hold numbers >= 1, got 0");
+  expect_one_line_error(run("train " + ok + " --set ppo.total_steps=0"), "key 'ppo.total_steps' must be > 0, got 0");
+  expect_one_line_error(run("train " + ok + " --set ppo.num_envs=100000000"), "key 'ppo.num_envs' must be in [1, 4096], got 100000000");
+  expect_one_line_error(run("train " + ok + " --set ppo.clip=-0.2"), "key 'ppo.clip' must be > 0, got -0.2");
   expect_one_line_error(run("train " + ok + " --set ppo.num_envs=2 --set ppo.steps_per_env=64"),
                         "key 'ppo.minibatch_size': 2048 is larger than a rollout (num_envs x steps_per_env = 128)");
-  expect_one_line_error(run("train " + ok + " --set threads=-3"), "key 'threads': must be >= 0");
-  expect_one_line_error(run("train " + ok + " --set eval.episodes=0"), "key 'eval.episodes': must be positive");
+  expect_one_line_error(run("train " + ok + " --set threads=-3"), "key 'threads' must be >= 0, got -3");
+  expect_one_line_error(run("train " + ok + " --set eval.episodes=0"), "key 'eval.episodes' must be > 0, got 0");
   const std::string serve = "eval --task serve --method tp --episodes 1 --recipe " + std::string(SEGUE_SOURCE_DIR) +
                             "/experiments/serve.yaml --set ";
-  expect_one_line_error(run(serve + "'switch.hidden=[0]'"), "key 'switch.hidden': layer widths must be positive, got 0");
+  // Policy files: each failure names the key that gave the file.
+  const std::string tiny = " --set run_dir=" + path("from_run") + " --set ppo.total_steps=2048";
+  expect_one_line_error(run("train " + ok + tiny + " --set init_from=assets/policies/walker/walker_forward.pt"),
+                        "walker_forward.pt: not a training checkpoint");
+  EXPECT_FALSE(std::filesystem::exists(dir_ / "from_run")) << "a refused start left its run directory";
+  auto garbage = write("garbage.pt", "not a policy\n");
+  expect_one_line_error(run("train " + ok + tiny + " --set init_policy=" + garbage),
+                        "key 'init_policy': " + garbage + ": not a TorchScript policy");
+  expect_one_line_error(run("eval --task serve --method single --episodes 1 --set methods.single.policy=" + garbage),
+                        "key 'methods.single.policy': " + garbage + ": not a TorchScript policy");
+  // Settings the model cannot hold, found when the task is built.
+  auto jump = write("jump.yaml", "task: walker_jump\n");
+  expect_one_line_error(run("train " + jump + " --check --set env.curbs=100"),
+                        "jump.yaml: key 'env': walker_jump: env.curbs asks for 100 curbs and 0 ceilings");
+  expect_one_line_error(run("train " + ok + " --set policy.activation=elu"),
+                        "key 'policy.activation' must be one of tanh, relu, got 'elu'");
+  expect_one_line_error(run(serve + "'switch.hidden=[0]'"), "key 'switch.hidden' must hold numbers >= 1, got 0");
   expect_one_line_error(run(serve + "'eval.seeds=[]'"), "key 'eval.seeds': lists no seed");
   expect_one_line_error(run(serve + "'transitions=[]'"), "key 'transitions': lists no transition");
   expect_one_line_error(run(serve + "'transitions.1={from: toss, to: hit}'"),

@@ -66,17 +66,22 @@ Policy load_init_policy(const SkillRecipe& s, const std::string& recipe_path, co
   const std::string from = repo_path(s.init_policy);
   if (!std::filesystem::exists(from))
     throw Error(recipe_path + ": key 'init_policy': no such policy '" + s.init_policy + "'");
-  Policy start = Policy::load(from);
+  Policy start = [&] {
+    try {
+      return Policy::load(from);
+    } catch (const Error& e) {
+      throw Error(recipe_path + ": key 'init_policy': " + e.what());
+    }
+  }();
   start.check_fits(spec, recipe_path + ": key 'init_policy': '" + s.init_policy + "'", prefix);
   return start;
 }
 
 // Evolution strategies from init_policy: a checkpoint (with the step and time counters),
 // policy.pt (theta, to evaluate mid-run) and a metrics row every generation.
-int train_es(const SkillRecipe& s, const Recipe& recipe, const std::string& recipe_path, RunDir& dir,
-             int threads) {
+int train_es(const SkillRecipe& s, const Policy& start, const Recipe& recipe, const std::string& recipe_path,
+             RunDir& dir, int threads) {
   const EsConfig& cfg = *s.es;
-  const Policy start = load_init_policy(s, recipe_path, s.make_env()->spec(), /*prefix=*/false);
   const SearchedParameters space = [&] {
     try {
       return SearchedParameters(start, cfg.inputs);
@@ -325,25 +330,37 @@ int train_skill(const Recipe& recipe, const SkillRecipe& s) {
   // fixed thread count keeps floating-point sums, and so the trained policy, the same
   // whatever `threads` is. `threads` parallelises environment stepping only.
   set_torch_threads(1);
-  // Rank 0 keeps the run directory; the other ranks learn from it whether to resume.
+  // Rank 0 keeps the run directory; the other ranks learn from it whether to resume. A
+  // fresh run reads its starting point before the directory is made, so that a refused
+  // init_from or init_policy leaves no recipe behind for the corrected one to clash with.
   std::optional<RunDir> dir;
-  if (group.leader()) dir.emplace(s.run_dir, recipe.resolved_yaml(), recipe.defaulted_keys());
+  auto make_dir = [&] {
+    if (group.leader()) dir.emplace(s.run_dir, recipe.resolved_yaml(), recipe.defaulted_keys());
+  };
+  const std::string checkpoint = s.run_dir + "/checkpoint.pt";
+  const bool resume = group.any(group.leader() && std::filesystem::exists(checkpoint));
   if (s.es) {
     if (!group.single()) throw Error(recipe_path + ": key 'es': evolution strategies run on one process (drop --nproc)");
-    return train_es(s, recipe, recipe_path, *dir, threads);
+    const Policy start = load_init_policy(s, recipe_path, s.make_env()->spec(), /*prefix=*/false);
+    make_dir();
+    return train_es(s, start, recipe, recipe_path, *dir, threads);
   }
-  const std::string checkpoint = s.run_dir + "/checkpoint.pt";
   const Shard share = group.shard(s.ppo.num_envs, recipe_path + ": key 'ppo.num_envs'");
   VectorEnv envs(s.make_env, share.count, threads, share.first);
   PPO ppo(s.ppo, s.net, envs, s.seed, group);
-  if (group.any(dir && dir->has_checkpoint())) {
+  if (resume) {
+    make_dir();  // first: a different recipe is refused before its checkpoint is read
     ppo.load(checkpoint);
     spdlog::info("resuming {} from iteration {} ({} steps)", s.run_dir, ppo.iteration(), ppo.global_step());
   } else if (!s.init_from.empty()) {
     const std::string from = repo_path(s.init_from);
     if (group.leader() && !std::filesystem::exists(from))
       throw Error(recipe_path + ": key 'init_from': no such checkpoint '" + s.init_from + "'");
-    ppo.load(from, {}, /*resume_episodes=*/false);
+    try {
+      ppo.load(from, {}, /*resume_episodes=*/false);
+    } catch (const Error& e) {
+      throw Error(recipe_path + ": key 'init_from': " + e.what());
+    }
     if (!std::isnan(s.init_log_std)) ppo.set_log_std(s.init_log_std);
     if (s.restart_lr_schedule) ppo.restart_lr_schedule();
     spdlog::info("training {} in {} from {} (iteration {}, {} steps) to {} steps", s.task, s.run_dir, s.init_from,
@@ -364,6 +381,7 @@ int train_skill(const Recipe& recipe, const SkillRecipe& s) {
     spdlog::info("training {} in {} ({} steps) on {} ranks, {} threads each", s.task, s.run_dir, s.ppo.total_steps,
                  group.size(), threads);
   }
+  if (!resume) make_dir();
   std::optional<MetricsCsv> csv;
   if (group.leader())
     csv.emplace(dir->file("metrics.csv"),
