@@ -1,5 +1,6 @@
 #include "algorithms/skill_recipe.h"
 
+#include "core/thread_pool.h"
 #include "environments/registry.h"
 
 namespace segue {
@@ -9,7 +10,7 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   SkillRecipe s;
   s.task = root.require<std::string>("task");
   s.seed = root.get<uint64_t>("seed", s.seed);
-  s.threads = root.get("threads", s.threads, Range::non_negative());  // 0: all cores
+  s.threads = root.get("threads", s.threads, Range::closed(0, kMaxThreads));  // 0: all cores
   s.run_dir = root.get("run_dir", default_run_dir);
   s.checkpoint_every = root.get("checkpoint_every", s.checkpoint_every, Range::positive());
   s.init_from = root.get<std::string>("init_from", "");

@@ -41,7 +41,9 @@ class ThreadPool {
   std::exception_ptr error_;        // the current job's first exception (under mutex_)
 };
 
-// Threads to use for a "threads" setting: 0 means every core.
+// Threads to use for a "threads" setting: 0 means every core. A setting above
+// kMaxThreads is refused where it is read (a typo must not start a million threads).
+constexpr int kMaxThreads = 1024;
 int resolve_threads(int requested);
 
 }  // namespace segue

@@ -4,54 +4,95 @@
 
 #include <spdlog/spdlog.h>
 
+#include <functional>
+#include <optional>
 #include <sstream>
 
 #include "algorithms/mlp.h"
 #include "core/rng.h"
+#include "core/thread_pool.h"
 #include "core/run_dir.h"
 #include "environments/registry.h"
 
 namespace segue {
 
+namespace {
+
+// Runs episode(i, e, part) for episodes e = 0, 1, ... in blocks of one per worker (i is
+// the episode's place in its block, so each may own a context), and hands each part to
+// take(e, part) in episode order until take returns false. The parts taken are those of
+// the one-thread loop, however many threads run the episodes: each is seeded by e alone.
+template <class Part>
+void episodes_in_order(int threads, int max_episodes, const std::atomic<int>* stop,
+                       const std::function<void(int, int, Part&)>& episode,
+                       const std::function<bool(int, Part&)>& take) {
+  ThreadPool pool(std::max(1, threads));
+  std::vector<Part> parts(size_t(pool.size()));
+  for (int first = 0; first < max_episodes; first += pool.size()) {
+    if (stop && stop->load()) return;
+    const int n = std::min(pool.size(), max_episodes - first);
+    pool.parallel_for(n, [&](int i, int) { episode(i, first + i, parts[size_t(i)]); });
+    for (int i = 0; i < n; ++i)
+      if (!take(first + i, parts[size_t(i)])) return;
+  }
+}
+
+}  // namespace
+
 StartStates collect_start_states(const CompositeRecipe& r, int transition, int count, uint64_t seed,
                                  const std::vector<TransitionArtefacts>& trained, int max_episodes,
-                                 const std::atomic<int>* stop) {
-  auto env = r.make_env();
-  const EnvSpec& spec = env->spec();
+                                 const std::atomic<int>* stop, int threads) {
   bool any_q = false;
   for (const auto& a : trained) any_q |= bool(a.q);
-  TransitionController controller(r.skills, r.meta, trained, any_q ? SwitchRule::QNetwork : SwitchRule::IntervalEnd);
-  std::vector<float> obs(spec.obs_dim), act(spec.act_dim);
-  std::vector<double> state;
+  struct Worker {
+    std::unique_ptr<Env> env;
+    std::optional<TransitionController> controller;
+    std::vector<float> obs, act;
+    std::vector<double> state;
+  };
+  std::vector<Worker> workers(size_t(std::max(1, threads)));
+  for (auto& w : workers) {
+    w.env = r.make_env();
+    w.controller.emplace(r.skills, r.meta, trained, any_q ? SwitchRule::QNetwork : SwitchRule::IntervalEnd);
+    w.obs.resize(w.env->spec().obs_dim), w.act.resize(w.env->spec().act_dim);
+  }
   StartStates out;
   out.source = r.transition_source(transition);
-  out.obs_dim = spec.obs_dim;
+  out.obs_dim = workers[0].env->spec().obs_dim;
   Progress progress("S_a " + r.transition_name(transition), count, 0, "state");
-  for (int e = 0; e < max_episodes && out.size() < count; ++e) {
-    if (stop && stop->load()) return out;
-    env->reset(mix_seed(seed, e), obs.data());
-    controller.reset(*env, obs.data());
-    for (bool done = false; !done && out.size() < count;) {
-      // The interval a->b begins where the meta-controller hands a's phase to b. That phase
-      // may be driven by a transition policy into a rather than by pi_a itself: on Patrol,
-      // balance->walk begins at the very step walk->balance's interval ends, so balance
-      // never runs alone and "pi_a in control" would find no state at all.
-      env->save_state(state);
-      controller.act(*env, obs.data(), act.data());
-      if (controller.entered() == transition) {  // the hand-over to b happened at this state
-        out.state_dim = int(state.size());
-        out.states.insert(out.states.end(), state.begin(), state.end());
-        out.obs.insert(out.obs.end(), obs.begin(), obs.end());  // act() leaves obs as it was
-      }
-      done = env->step(act.data(), obs.data()).done();
-    }
-    // A late interval is reached only as often as every earlier hand-over succeeds.
-    progress.update(out.size(), NAN, NAN);
-    if (out.size() == 0 && e + 1 == kEmptyEpisodes) {
-      max_episodes = e + 1;
-      break;
-    }
-  }
+  episodes_in_order<StartStates>(
+      threads, max_episodes, stop,
+      [&](int i, int e, StartStates& part) {
+        Worker& w = workers[size_t(i)];
+        part = StartStates();
+        part.obs_dim = out.obs_dim;
+        w.env->reset(mix_seed(seed, e), w.obs.data());
+        w.controller->reset(*w.env, w.obs.data());
+        for (bool done = false; !done;) {
+          // The interval a->b begins where the meta-controller hands a's phase to b. That
+          // phase may be driven by a transition policy into a rather than by pi_a itself:
+          // on Patrol, balance->walk begins at the very step walk->balance's interval ends,
+          // so balance never runs alone and "pi_a in control" would find no state at all.
+          w.env->save_state(w.state);
+          w.controller->act(*w.env, w.obs.data(), w.act.data());
+          if (w.controller->entered() == transition) {  // the hand-over to b happened at this state
+            part.state_dim = int(w.state.size());
+            part.states.insert(part.states.end(), w.state.begin(), w.state.end());
+            part.obs.insert(part.obs.end(), w.obs.begin(), w.obs.end());  // act() leaves obs as it was
+          }
+          done = w.env->step(w.act.data(), w.obs.data()).done();
+        }
+      },
+      [&](int e, StartStates& part) {
+        if (part.size() > 0) out.state_dim = part.state_dim;
+        part.keep_first(count - out.size());
+        out.append(part);
+        // A late interval is reached only as often as every earlier hand-over succeeds.
+        progress.update(out.size(), NAN, NAN);
+        if (out.size() == 0 && e + 1 == kEmptyEpisodes) max_episodes = e + 1;
+        return out.size() < count && e + 1 < max_episodes;
+      });
+  if (stop && stop->load()) return out;
   if (out.size() < count)
     throw Error(r.file + ": transition " + r.transition_name(transition) + " was entered only " +
                 std::to_string(out.size()) + " times in " + std::to_string(max_episodes) +
@@ -60,7 +101,8 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
 }
 
 Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, int count, uint64_t seed,
-                                      int max_episodes, const std::atomic<int>* stop, const StartStates* handovers) {
+                                      int max_episodes, const std::atomic<int>* stop, const StartStates* handovers,
+                                      int threads) {
   const Transition& tr = r.meta.transitions().at(transition);
   const bool own_task = !tr.expert_task.empty();
   if (tr.expert_after_handover) {
@@ -69,8 +111,6 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
                   ": expert.after_handover needs S_a's states, and none were given");
     max_episodes = handovers->size();  // restores are exact and pi_b deterministic: once each
   }
-  auto env = own_task ? reference_task_factory(tr.expert_task)() : r.make_env();
-  const EnvSpec& spec = env->spec();
   Skill b = r.skills[tr.to];
   const int D = b.obs_end - b.obs_begin;
   // On its own sub-task (checked at load to have D numbers) pi_b sees all of them.
@@ -78,56 +118,81 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
     b.obs_begin = 0;
     b.obs_end = D;
   }
-  std::vector<float> obs(spec.obs_dim), act(spec.act_dim), prev(D);
-  std::vector<double> f(spec.feature_names.size()), state;
-  Demonstrations out, window;  // window: this episode's steps, added to out once kept
-  out.source = r.transition_source(transition);
-  out.obs_dim = window.obs_dim = D;
-  out.act_dim = window.act_dim = spec.act_dim;
-  Progress progress("T_b " + r.transition_name(transition), count, 0, "step");
-  for (int e = 0; e < max_episodes && out.size() < count; ++e) {
-    if (stop && stop->load()) return out;
-    if (tr.expert_after_handover) {
-      handovers->state(e, state);
-      env->restore_state(state, obs.data());
-    } else {
-      env->reset(mix_seed(seed, e), obs.data());
-    }
-    window.clear();
-    bool entered = false, past = false, done = false, succeeded = false;
-    int successes = 0, at_entry = 0;  // the task's success count, now and on entering
-    // With expert_successful a window is seen to its end, then pi_b runs on to its success.
-    for (int t = 0; !done && (tr.expert_successful || out.size() + window.size() < count); ++t) {
-      env->features(f.data());
-      const bool inside = (!own_task || tr.expert_steps == 0 || t < tr.expert_steps) &&
-                          MetaController::holds(tr.expert_when, f.data());
-      past |= entered && !inside;  // one window per episode
-      if (past && (succeeded || !tr.expert_successful)) break;
-      if (!entered && inside) at_entry = successes;
-      entered |= inside;
-      std::copy(obs.begin() + b.obs_begin, obs.begin() + b.obs_end, prev.begin());
-      b.policy.act(prev.data(), 1, act.data());
-      StepResult sr = env->step(act.data(), obs.data());
-      done = sr.done();
-      successes = sr.info.success_count;
-      // A restored episode's count so far is first seen after a step; no success is won in
-      // the one step after pi_a hands over.
-      if (t == 0 && tr.expert_after_handover) at_entry = successes;
-      succeeded |= entered && successes > at_entry;
-      if (inside && !past) {
-        window.obs.insert(window.obs.end(), prev.begin(), prev.end());
-        window.act.insert(window.act.end(), act.begin(), act.end());
-        window.next_obs.insert(window.next_obs.end(), obs.begin() + b.obs_begin, obs.begin() + b.obs_end);
-        window.done.push_back(sr.terminated);
-      }
-    }
-    if (succeeded || !tr.expert_successful) out.append(window);
-    progress.update(std::min(out.size(), count), NAN, NAN);
-    if (out.size() == 0 && e + 1 == kEmptyEpisodes) {
-      max_episodes = e + 1;
-      break;
-    }
+  struct Worker {
+    std::unique_ptr<Env> env;
+    Skill b;  // an own copy: Policy::act keeps scratch buffers
+    std::vector<float> obs, act, prev;
+    std::vector<double> f, state;
+  };
+  std::vector<Worker> workers(size_t(std::max(1, threads)));
+  for (auto& w : workers) {
+    w.env = own_task ? reference_task_factory(tr.expert_task)() : r.make_env();
+    w.b = b;
+    w.obs.resize(w.env->spec().obs_dim), w.act.resize(w.env->spec().act_dim), w.prev.resize(D);
+    w.f.resize(w.env->spec().feature_names.size());
   }
+  // An episode's part: its window of pi_b's steps, and whether it is kept.
+  struct Window {
+    Demonstrations steps;
+    bool kept = false;
+  };
+  Demonstrations out;
+  out.source = r.transition_source(transition);
+  out.obs_dim = D;
+  out.act_dim = workers[0].env->spec().act_dim;
+  Progress progress("T_b " + r.transition_name(transition), count, 0, "step");
+  episodes_in_order<Window>(
+      threads, max_episodes, stop,
+      [&](int i, int e, Window& part) {
+        Worker& w = workers[size_t(i)];
+        Demonstrations& window = part.steps;
+        window.obs_dim = D, window.act_dim = out.act_dim;
+        window.clear();
+        if (tr.expert_after_handover) {
+          handovers->state(e, w.state);
+          w.env->restore_state(w.state, w.obs.data());
+        } else {
+          w.env->reset(mix_seed(seed, e), w.obs.data());
+        }
+        bool entered = false, past = false, done = false, succeeded = false;
+        int successes = 0, at_entry = 0;  // the task's success count, now and on entering
+        // With expert_successful a window is seen to its end, then pi_b runs on to its success.
+        for (int t = 0; !done; ++t) {
+          w.env->features(w.f.data());
+          const bool inside = (!own_task || tr.expert_steps == 0 || t < tr.expert_steps) &&
+                              MetaController::holds(tr.expert_when, w.f.data());
+          past |= entered && !inside;  // one window per episode
+          if (past && (succeeded || !tr.expert_successful)) break;
+          if (!entered && inside) at_entry = successes;
+          entered |= inside;
+          std::copy(w.obs.begin() + w.b.obs_begin, w.obs.begin() + w.b.obs_end, w.prev.begin());
+          w.b.policy.act(w.prev.data(), 1, w.act.data());
+          StepResult sr = w.env->step(w.act.data(), w.obs.data());
+          done = sr.done();
+          successes = sr.info.success_count;
+          // A restored episode's count so far is first seen after a step; no success is won
+          // in the one step after pi_a hands over.
+          if (t == 0 && tr.expert_after_handover) at_entry = successes;
+          succeeded |= entered && successes > at_entry;
+          if (inside && !past) {
+            window.obs.insert(window.obs.end(), w.prev.begin(), w.prev.end());
+            window.act.insert(window.act.end(), w.act.begin(), w.act.end());
+            window.next_obs.insert(window.next_obs.end(), w.obs.begin() + w.b.obs_begin, w.obs.begin() + w.b.obs_end);
+            window.done.push_back(sr.terminated);
+          }
+        }
+        part.kept = succeeded || !tr.expert_successful;
+      },
+      [&](int e, Window& part) {
+        // Without expert_successful, T_b is cut at `count` steps; with it, an episode's
+        // window is kept whole.
+        if (!tr.expert_successful) part.steps.keep_first(count - out.size());
+        if (part.kept) out.append(part.steps);
+        progress.update(std::min(out.size(), count), NAN, NAN);
+        if (out.size() == 0 && e + 1 == kEmptyEpisodes) max_episodes = e + 1;
+        return out.size() < count && e + 1 < max_episodes;
+      });
+  if (stop && stop->load()) return out;
   if (out.size() < count && !(tr.expert_after_handover && out.size() > 0))
     throw Error(r.file + ": pi_b of transition " + r.transition_name(transition) + " gave only " +
                 std::to_string(out.size()) + " demonstration steps in " + std::to_string(max_episodes) +

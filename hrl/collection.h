@@ -51,6 +51,12 @@ struct Demonstrations {
   std::vector<uint8_t> done;              // 1 where the episode truly ended
   int size() const { return obs_dim ? int(obs.size() / obs_dim) : 0; }
   void clear() { obs.clear(), act.clear(), next_obs.clear(), done.clear(); }
+  // Keeps the first n rows (all if there are fewer).
+  void keep_first(int n) {
+    n = std::max(0, std::min(n, size()));
+    obs.resize(size_t(n) * obs_dim), act.resize(size_t(n) * act_dim), next_obs.resize(size_t(n) * obs_dim);
+    done.resize(size_t(n));
+  }
   void append(const Demonstrations& d) {
     obs.insert(obs.end(), d.obs.begin(), d.obs.end());
     act.insert(act.end(), d.act.begin(), d.act.end());
@@ -66,15 +72,17 @@ struct Demonstrations {
 // `trained`: per transition of the recipe, its pi_ab and q_ab where already trained (or
 // empty). Episodes use q_ab where there is one, else switch at the interval's end.
 // `stop` (a signal's flag): when set, both return at the next episode with what they have.
+// `threads` run episodes side by side; the result is the one-thread loop's.
 constexpr int kStartStateEpisodes = 20000, kDemonstrationEpisodes = 100000;  // default max_episodes
 constexpr int kEmptyEpisodes = 1000;
 StartStates collect_start_states(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
                                  const std::vector<TransitionArtefacts>& trained = {},
-                                 int max_episodes = kStartStateEpisodes, const std::atomic<int>* stop = nullptr);
+                                 int max_episodes = kStartStateEpisodes, const std::atomic<int>* stop = nullptr,
+                                 int threads = 1);
 // `handovers`: S_a's training states, required with expert.after_handover.
 Demonstrations collect_demonstrations(const CompositeRecipe& recipe, int transition, int count, uint64_t seed,
                                       int max_episodes = kDemonstrationEpisodes, const std::atomic<int>* stop = nullptr,
-                                      const StartStates* handovers = nullptr);
+                                      const StartStates* handovers = nullptr, int threads = 1);
 
 void save(const StartStates& s, const std::string& path);
 void save(const Demonstrations& d, const std::string& path);

@@ -99,7 +99,7 @@ int collect_shared(const Distributed& group, const std::string& file, int count,
 
 // Returns the signal number when stopped (nothing of the unfinished set is kept), else 0.
 int collect(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
-            const std::atomic<int>* stop, const Distributed& group) {
+            const std::atomic<int>* stop, const Distributed& group, int threads) {
   const CollectConfig& c = r.pipeline.collect;
   if (!group.any(group.leader() && exists(dir + "/start_states.pt"))) {
     const int count = r.start_state_count(t);
@@ -107,7 +107,7 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
     const auto trained = load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false);
     if (int sig = collect_shared<StartStates>(
             group, dir + "/start_states.pt", count, mix_seed(r.pipeline.seed, 2 * t), stop,
-            [&](int n, uint64_t seed) { return collect_start_states(r, t, n, seed, trained, kStartStateEpisodes, stop); },
+            [&](int n, uint64_t seed) { return collect_start_states(r, t, n, seed, trained, kStartStateEpisodes, stop, threads); },
             load_start_states))
       return sig;
   }
@@ -137,7 +137,7 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
     return collect_shared<Demonstrations>(
         group, dir + "/demonstrations.pt", c.demonstrations, mix_seed(r.pipeline.seed, 2 * t + 1), stop,
         [&](int n, uint64_t seed) {
-          return collect_demonstrations(r, t, n, seed, kDemonstrationEpisodes, stop, &handovers);
+          return collect_demonstrations(r, t, n, seed, kDemonstrationEpisodes, stop, &handovers, threads);
         },
         load_demonstrations);
   }
@@ -372,7 +372,7 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
     if (group.leader()) fs::create_directories(tdir(t));
     group.leader_done("the transition's folder");
     announce(recipe.transition_name(t) + ": collect S_a and T_b");
-    if (int stop = collect(recipe, t, run, tdir(t), o.stop, group)) {
+    if (int stop = collect(recipe, t, run, tdir(t), o.stop, group, o.threads)) {
       spdlog::warn("interrupted: rerun the same command to resume (this collection starts over)");
       return stop;
     }

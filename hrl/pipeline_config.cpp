@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/thread_pool.h"
+
 namespace segue {
 namespace {
 // Bounds on what a run stores (rows of states or demonstrations, a replay buffer) and on a
@@ -93,7 +95,7 @@ PipelineConfig PipelineConfig::read(const Section& root, const std::string& task
   PipelineConfig c;
   c.run_dir = root.get("run_dir", "runs/" + task);
   c.seed = root.get<uint64_t>("seed", c.seed);
-  c.threads = root.get("threads", c.threads, Range::non_negative());
+  c.threads = root.get("threads", c.threads, Range::closed(0, kMaxThreads));
   c.collect = CollectConfig::read(root.sub("collect"));
   c.transition = TransitionPolicyConfig::read(root.sub("transition"), obs_dim);
   c.switching = SwitchConfig::read(root.sub("switch"), obs_dim);

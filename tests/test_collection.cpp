@@ -121,6 +121,23 @@ TEST_F(CollectionFiles, DemonstrationsArePiBsOwnStepsInItsWindow) {
   EXPECT_EQ(s2.source, back.source);
 }
 
+TEST(Collection, ThreadsRunEpisodesSideBySideToTheOneThreadResult) {
+  CompositeRecipe r = patrol();
+  // 5 states and 333 steps: the last episode taken is cut part-way in both.
+  const StartStates one = collect_start_states(r, 0, 5, 11);
+  const StartStates three = collect_start_states(r, 0, 5, 11, {}, kStartStateEpisodes, nullptr, /*threads=*/3);
+  ASSERT_EQ(one.size(), 5);
+  EXPECT_EQ(one.states, three.states);
+  EXPECT_EQ(one.obs, three.obs);
+  const Demonstrations d1 = collect_demonstrations(r, 0, 333, 12);
+  const Demonstrations d3 = collect_demonstrations(r, 0, 333, 12, kDemonstrationEpisodes, nullptr, nullptr, 3);
+  ASSERT_EQ(d1.size(), 333);
+  EXPECT_EQ(d1.obs, d3.obs);
+  EXPECT_EQ(d1.act, d3.act);
+  EXPECT_EQ(d1.next_obs, d3.next_obs);
+  EXPECT_EQ(d1.done, d3.done);
+}
+
 TEST(Collection, StartStatesWhereATransitionPolicyIntoAHandsOver) {
   // On Patrol balance never runs alone: With TP, walk->balance's pi_ab drives the 100
   // balance steps and balance->walk's interval begins the step after. S_a of balance->
@@ -282,6 +299,8 @@ TEST_F(CollectionFiles, SuccessfulDemonstrationsAreTheWindowsPiBSucceedsFrom) {
   EXPECT_GT(kept, 0);
   EXPECT_GT(dropped, 0);  // the jump fails from some windows: they are not in T_b
   EXPECT_EQ(d.obs, want);
+  EXPECT_EQ(collect_demonstrations(r, 0, count, 11, kDemonstrationEpisodes, nullptr, nullptr, 2).obs, d.obs)
+      << "two threads keep other windows";
 }
 
 TEST_F(CollectionFiles, ExpertWindowsAreCheckedAtLoadAndAfterAThousandEmptyEpisodes) {

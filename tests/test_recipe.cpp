@@ -227,7 +227,7 @@ TEST_F(CliErrors, NonsenseRefusedBeforeWork) {
   expect_one_line_error(run("train " + ok + " --set ppo.clip=-0.2"), "key 'ppo.clip' must be > 0, got -0.2");
   expect_one_line_error(run("train " + ok + " --set ppo.num_envs=2 --set ppo.steps_per_env=64"),
                         "key 'ppo.minibatch_size': 2048 is larger than a rollout (num_envs x steps_per_env = 128)");
-  expect_one_line_error(run("train " + ok + " --set threads=-3"), "key 'threads' must be >= 0, got -3");
+  expect_one_line_error(run("train " + ok + " --set threads=-3"), "key 'threads' must be in [0, 1024], got -3");
   expect_one_line_error(run("train " + ok + " --set eval.episodes=0"), "key 'eval.episodes' must be > 0, got 0");
   const std::string serve = "eval --task serve --method tp --episodes 1 --recipe " + std::string(SEGUE_SOURCE_DIR) +
                             "/experiments/serve.yaml --set ";
@@ -241,6 +241,14 @@ TEST_F(CliErrors, NonsenseRefusedBeforeWork) {
                         "key 'init_policy': " + garbage + ": not a TorchScript policy");
   expect_one_line_error(run("eval --task serve --method single --episodes 1 --set methods.single.policy=" + garbage),
                         "key 'methods.single.policy': " + garbage + ": not a TorchScript policy");
+  // Flags and commands: the same one line and exit code 1.
+  const std::string forward = " " + std::string(SEGUE_SOURCE_DIR) + "/assets/policies/walker/walker_forward.pt --task walker_forward";
+  expect_one_line_error(run("eval" + forward + " --seed -1"), "segue eval: --seed must be >= 0, got -1");
+  expect_one_line_error(run("eval" + forward + " --threads 100000"), "segue eval: --threads must be in [0, 1024], got 100000");
+  expect_one_line_error(run("render" + forward + " --out " + path("missing/x.mp4")),
+                        "segue render: --out " + path("missing/x.mp4") + ": no folder");
+  expect_one_line_error(run("nosuchcommand"), "unknown command 'nosuchcommand' (commands: train, run,");
+  expect_one_line_error(run("plot " + dir_.string()), "neither metrics.csv nor */transition.csv");
   // Settings the model cannot hold, found when the task is built.
   auto jump = write("jump.yaml", "task: walker_jump\n");
   expect_one_line_error(run("train " + jump + " --check --set env.curbs=100"),

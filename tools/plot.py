@@ -187,7 +187,7 @@ def main():
             out = a.out or os.path.splitext(a.results)[0] + ".png"
             methods_chart(a.results, out)
     except InputError as e:
-        print(f"plot.py: {e}", file=sys.stderr)
+        print(f"error: {e}", file=sys.stderr)
         return 2
     print(f"wrote {out}")
     return 0

@@ -249,8 +249,8 @@ RankRates ppo_on_ranks(const std::string& recipe, const SkillRecipe& s, int rank
 int bench_main(int argc, char** argv) {
   Args args(kBench, argc, argv);
   if (args.help()) return print_help(kBench);
-  const int iterations = args.get_int("iterations", 5), steps = args.get_int("steps", 100000);
-  if (iterations <= 0 || steps <= 0) throw Error("segue bench: --iterations and --steps must be positive");
+  const int iterations = args.get_int("iterations", 5, Range::positive()),
+            steps = args.get_int("steps", 100000, Range::positive());
   const int cores = resolve_threads(0);
   const double ts = testspeed(asset_path("walker/walker.xml"), steps);
   std::vector<std::pair<std::string, double>> json{{"testspeed_sps", ts}, {"cores", double(cores)}};

@@ -54,16 +54,20 @@ std::string Args::get(const std::string& flag, const std::string& fallback) cons
   return it == values_.end() ? fallback : it->second;
 }
 
-int Args::get_int(const std::string& flag, int fallback) const {
+int Args::get_int(const std::string& flag, int fallback, const Range& range) const {
   auto it = values_.find(flag);
   if (it == values_.end()) return fallback;
+  int v = 0;
   try {
     size_t used;
-    int v = std::stoi(it->second, &used);
-    if (used == it->second.size()) return v;
+    v = std::stoi(it->second, &used);
+    if (used != it->second.size()) throw Error("");
   } catch (const std::exception&) {
+    throw Error("segue " + cmd_.name + ": --" + flag + " expects an integer, got '" + it->second + "'");
   }
-  throw Error("segue " + cmd_.name + ": --" + flag + " expects an integer, got '" + it->second + "'");
+  if (!range.contains(v))
+    throw Error("segue " + cmd_.name + ": --" + flag + " must be " + range.text() + ", got " + it->second);
+  return v;
 }
 
 std::vector<std::string> Args::all(const std::string& flag) const {

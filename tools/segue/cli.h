@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "core/error.h"
+#include "core/recipe.h"
+#include "core/thread_pool.h"
 
 namespace segue::cli {
 
@@ -33,7 +35,8 @@ class Args {
   size_t positional_count() const { return positionals_.size(); }
   bool has(const std::string& flag) const { return values_.count(flag) > 0; }
   std::string get(const std::string& flag, const std::string& fallback) const;
-  int get_int(const std::string& flag, int fallback) const;
+  // An integer flag, refused unless in `range`.
+  int get_int(const std::string& flag, int fallback, const Range& range) const;
   std::vector<std::string> all(const std::string& flag) const;
 
  private:

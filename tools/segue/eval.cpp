@@ -36,10 +36,9 @@ int eval_main(int argc, char** argv) {
   if (args.help()) return print_help(kEval);
   if (!args.has("task")) throw Error("segue eval: --task NAME is required (see segue eval --help)");
   const std::string task = args.get("task", "");
-  const int episodes = args.get_int("episodes", 50);
-  if (episodes <= 0) throw Error("segue eval: --episodes must be positive");
-  const int seed = args.get_int("seed", 0);
-  const int threads = resolve_threads(args.get_int("threads", 0));
+  const int episodes = args.get_int("episodes", 50, Range::positive());
+  const int seed = args.get_int("seed", 0, Range::non_negative());
+  const int threads = resolve_threads(args.get_int("threads", 0, Range::closed(0, kMaxThreads)));
   set_torch_threads(1);
   const std::string method = args.get("method", "");
   std::string label;

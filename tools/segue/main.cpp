@@ -44,8 +44,8 @@ int dispatch(const std::string& cmd, int argc, char** argv) {
   if (cmd == "report") return segue::cli::report_main(argc, argv);
   if (cmd == "plot") return segue::cli::plot_main(argc, argv);
   if (cmd == "keys") return segue::cli::keys_main(argc, argv);
-  std::fprintf(stderr, "segue: unknown command '%s'\n\n%s", cmd.c_str(), kUsage);
-  return 2;
+  throw segue::Error("unknown command '" + cmd +
+                     "' (commands: train, run, eval, report, export, render, plot, keys, bench; see segue --help)");
 }
 
 // Takes `--nproc N` out of the command line; 0 if absent.

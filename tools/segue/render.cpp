@@ -291,9 +291,10 @@ int render_main(int argc, char** argv) {
   const std::string source = args.positional(0);
   if (!args.has("out") && !args.has("frames"))
     throw Error("segue render: --out FILE.mp4 or --frames DIR is required (see segue render --help)");
-  const int seed = args.get_int("seed", 0), width = args.get_int("width", 640),
-            height = args.get_int("height", 480), fps = args.get_int("fps", 30);
-  if (width <= 0 || height <= 0 || fps <= 0) throw Error("segue render: --width, --height and --fps must be positive");
+  const int seed = args.get_int("seed", 0, Range::non_negative()),
+            width = args.get_int("width", 640, Range::closed(16, 8192)),
+            height = args.get_int("height", 480, Range::closed(16, 8192)),
+            fps = args.get_int("fps", 30, Range::closed(1, 1000));
 
   // The task's environment and the policy: from a recipe's run directory or a policy file.
   std::string task, policy_path = source;
@@ -321,11 +322,13 @@ int render_main(int argc, char** argv) {
   set_torch_threads(1);
   Policy policy = Policy::load(policy_path);
   policy.check_fits(spec, policy_path);
-  const int steps = args.get_int("steps", spec.max_episode_steps);
-  if (steps <= 0) throw Error("segue render: --steps must be positive");
+  const int steps = args.get_int("steps", spec.max_episode_steps, Range::positive());
 
   // Where frames go: ffmpeg when asked for a video and available, else PNG files.
   std::string out = args.get("out", "");
+  const fs::path out_folder = fs::path(out).parent_path();
+  if (!out_folder.empty() && !fs::is_directory(out_folder))
+    throw Error("segue render: --out " + out + ": no folder '" + out_folder.string() + "'");
   fs::path frames_dir = args.get("frames", "");
   const bool video = frames_dir.empty() && on_path("ffmpeg");
   if (frames_dir.empty() && !video) {

@@ -42,7 +42,7 @@ int report_main(int argc, char** argv) {
   if (args.help()) return print_help(kReport);
   const std::string task = args.positional(0);
   CompositeRecipe r = CompositeRecipe::load(args.get("recipe", CompositeRecipe::default_file(task)));
-  const int threads = resolve_threads(args.get_int("threads", 0));
+  const int threads = resolve_threads(args.get_int("threads", 0, Range::closed(0, kMaxThreads)));
   set_torch_threads(1);
   std::vector<std::string> wanted = args.has("methods") ? split(args.get("methods", "")) : method_names();
   std::vector<std::pair<std::string, std::string>> skipped;  // method, why
