@@ -31,11 +31,9 @@ struct Range {
   static Range positive() { return {0, HUGE_VAL, true, false}; }
   static Range non_negative() { return {0, HUGE_VAL, false, false}; }
   static Range at_least(double lo) { return {lo, HUGE_VAL, false, false}; }
-  static Range above(double lo) { return {lo, HUGE_VAL, true, false}; }
   static Range at_most(double hi) { return {-HUGE_VAL, hi, false, false}; }
   static Range closed(double lo, double hi) { return {lo, hi, false, false}; }
   static Range open_closed(double lo, double hi) { return {lo, hi, true, false}; }
-  static Range closed_open(double lo, double hi) { return {lo, hi, false, true}; }
   bool contains(double v) const {
     return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi);
   }

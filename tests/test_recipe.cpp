@@ -67,12 +67,12 @@ TEST(Recipe, RangesAreCheckedWhereAKeyIsReadAndListed) {
   EXPECT_EQ(Range::positive().text(), "> 0");
   EXPECT_EQ(Range::non_negative().text(), ">= 0");
   EXPECT_EQ(Range::open_closed(0, 1).text(), "in (0, 1]");
-  EXPECT_EQ(Range::closed_open(-1.5, 2).text(), "in [-1.5, 2)");
+  EXPECT_EQ(Range::closed(-1.5, 2).text(), "in [-1.5, 2]");
   EXPECT_EQ(Range::at_most(0).text(), "<= 0");
   EXPECT_EQ(Range::any().text(), "any");
   EXPECT_TRUE(Range::open_closed(0, 1).contains(1));
   EXPECT_FALSE(Range::open_closed(0, 1).contains(0));
-  EXPECT_FALSE(Range::closed_open(0, 1).contains(1));
+  EXPECT_TRUE(Range::closed(0, 1).contains(0));
   Recipe r = Recipe::parse("a: -0.2\nb: [3, 0]\nc: 0.5\nd: relu\n", "r.yaml");
   auto message = [](const auto& read) {
     try {

@@ -1,4 +1,4 @@
-// segue keys: every recipe key the loaders read, with its default, as Markdown. Generated
+// segue keys: every recipe key the loaders read, with its type, range and default, as Markdown. Generated
 // from the code itself (each loader reads a minimal recipe; what it read, defaults
 // included, is listed), so docs/recipes.md, its output, cannot drift: a test compares them.
 #include <yaml-cpp/yaml.h>
@@ -19,7 +19,7 @@ namespace segue::cli {
 namespace {
 
 const Command kKeys{"keys", "",
-                    "Prints every recipe key with its default as Markdown (docs/recipes.md is this output).",
+                    "Prints every recipe key with its type, range and default as Markdown (docs/recipes.md is this output).",
                     {},
                     {}};
 

@@ -26,7 +26,7 @@ const char* kUsage =
     "  export CKPT OUT    write a checkpoint's policy as TorchScript\n"
     "  render POLICY      render one episode of a policy to a video, headless\n"
     "  plot RUN_DIR       draw a run's learning curves (PNG)\n"
-    "  keys               print every recipe key with its default (docs/recipes.md)\n"
+    "  keys               print every recipe key with its type, range and default (docs/recipes.md)\n"
     "  bench              measure physics, rollout and PPO throughput\n\n"
     "Run 'segue COMMAND --help' for a command's flags.\n";
 
