@@ -79,17 +79,21 @@ void set_path(YAML::Node root, const std::vector<std::string>& parts, const YAML
 }
 
 // yaml-cpp keeps both entries of a key written twice, and lookups find the first: a
-// recipe that sets a key twice is refused instead.
-void refuse_duplicate_keys(const YAML::Node& node, const std::string& prefix, const std::string& file) {
+// recipe that sets a key twice is refused instead. So is a key that is not a plain name
+// (YAML allows `? [1, 2]: x`; found by the fuzzer).
+void refuse_bad_keys(const YAML::Node& node, const std::string& prefix, const std::string& file) {
   if (node.IsMap()) {
     std::set<std::string> seen;
     for (const auto& kv : node) {
+      if (!kv.first.IsScalar())
+        throw Error(file + ": a key " + (prefix.empty() ? "at the top" : "under '" + prefix + "'") +
+                    " is not a plain name");
       const std::string key = kv.first.Scalar(), path = prefix.empty() ? key : prefix + "." + key;
       if (!seen.insert(key).second) throw Error(file + ": key '" + path + "' is given twice");
-      refuse_duplicate_keys(kv.second, path, file);
+      refuse_bad_keys(kv.second, path, file);
     }
   } else if (node.IsSequence()) {
-    for (size_t i = 0; i < node.size(); ++i) refuse_duplicate_keys(node[i], prefix + "." + std::to_string(i), file);
+    for (size_t i = 0; i < node.size(); ++i) refuse_bad_keys(node[i], prefix + "." + std::to_string(i), file);
   }
 }
 
@@ -234,7 +238,6 @@ Recipe Recipe::parse(const std::string& text, const std::string& name,
   }
   if (s->tree.IsNull()) s->tree = YAML::Node(YAML::NodeType::Map);
   if (!s->tree.IsMap()) throw Error(name + ": a recipe must be a mapping of keys");
-  refuse_duplicate_keys(s->tree, "", name);
   s->resolved = YAML::Node(YAML::NodeType::Map);
   for (const auto& o : overrides) {
     auto eq = o.find('=');
@@ -252,6 +255,7 @@ Recipe Recipe::parse(const std::string& text, const std::string& name,
     set_path(s->tree, split_key(key), value);
     s->overridden.insert(key);
   }
+  refuse_bad_keys(s->tree, "", name);  // the overrides' values included
   return Recipe(s);
 }
 

@@ -114,6 +114,16 @@ TEST(Recipe, WrongTypeAndMalformedYaml) {
     EXPECT_EQ(std::string(e.what()).rfind("m.yaml: malformed YAML at line", 0), 0u) << e.what();
   }
   EXPECT_THROW(Recipe::load("/nonexistent/recipe.yaml"), Error);
+  // A key must be a plain name, in the file and in --set values (a crash the fuzzer found).
+  for (const auto& [text, set] : std::vector<std::pair<std::string, std::string>>{
+           {"ppo:\n  ? [1, 2]\n  : 3\n", ""}, {"{}", "ppo={? [1]: 2}"}}) {
+    try {
+      Recipe::parse(text, "k.yaml", set.empty() ? std::vector<std::string>{} : std::vector<std::string>{set});
+      ADD_FAILURE() << text << set;
+    } catch (const Error& e) {
+      EXPECT_STREQ(e.what(), "k.yaml: a key under 'ppo' is not a plain name");
+    }
+  }
   EXPECT_THROW(Recipe::parse("{}", "r", {"no_equals_sign"}), Error);
 }
 
