@@ -23,7 +23,8 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   s.restart_lr_schedule = root.get("restart_lr_schedule", s.restart_lr_schedule);
   if (s.restart_lr_schedule && s.init_from.empty())
     throw root.error("restart_lr_schedule", "applies to a run that starts from init_from");
-  s.make_env = read_task(root, s.task);
+  EnvSpec spec;
+  s.make_env = read_task(root, s.task, spec);
   Section pol = root.sub("policy");
   s.net.pi_hidden = pol.layers("pi_hidden", s.net.pi_hidden);
   s.net.vf_hidden = pol.layers("vf_hidden", s.net.vf_hidden);
@@ -43,14 +44,13 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   s.eval_make_env = s.make_env;
   if (ev.get("reference_task", false))
     s.eval_make_env = reference_task_factory(s.task);
-  auto probe = s.make_env();
-  s.net.obs_dim = probe->spec().obs_dim;
+  s.net.obs_dim = spec.obs_dim;
   const auto& ig = s.net.ignore_obs;
   if (!ig.empty() && (ig.size() != 2 || ig[0] >= ig[1] || ig[1] > s.net.obs_dim))
     throw pol.error("ignore_obs", "must be [begin, end) with 0 <= begin < end <= " + std::to_string(s.net.obs_dim));
   // Read only when given, so older runs' resolved recipes stay the same.
   if (pol.has("fourier")) s.net.features = ObsFeatures::read(pol.sub("fourier"), s.net.obs_dim);
-  s.net.act_dim = probe->spec().act_dim;
+  s.net.act_dim = spec.act_dim;
   return s;
 }
 

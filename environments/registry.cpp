@@ -236,7 +236,7 @@ Factory task_factory(const std::string& task, const Section& env) {
   return it->second(task, env);
 }
 
-Factory read_task(const Section& root, const std::string& task) {
+Factory read_task(const Section& root, const std::string& task, EnvSpec& spec) {
   Factory make;
   try {
     make = task_factory(task, root.sub("env"));
@@ -245,7 +245,7 @@ Factory read_task(const Section& root, const std::string& task) {
     throw;
   }
   try {
-    make();
+    spec = make()->spec();
   } catch (const Error& e) {
     throw root.error("env", e.what());
   }

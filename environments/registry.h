@@ -15,8 +15,8 @@ namespace segue {
 std::function<std::unique_ptr<Env>()> task_factory(const std::string& task, const Section& env);
 // task_factory for a recipe: errors name the recipe's key ('task', 'env.*'), and one copy
 // is built, so that settings the model cannot hold (more curbs than it has) are refused
-// before any work.
-std::function<std::unique_ptr<Env>()> read_task(const Section& root, const std::string& task);
+// before any work; its spec goes to `spec`.
+std::function<std::unique_ptr<Env>()> read_task(const Section& root, const std::string& task, EnvSpec& spec);
 // The task with every setting at its reference value.
 std::function<std::unique_ptr<Env>()> reference_task_factory(const std::string& task);
 std::vector<std::string> task_names();

@@ -18,8 +18,7 @@ CompositeRecipe CompositeRecipe::load(const std::string& file, const std::vector
   CompositeRecipe c;
   c.file = file;
   c.task = root.require<std::string>("task");
-  c.make_env = read_task(root, c.task);
-  c.spec = c.make_env()->spec();
+  c.make_env = read_task(root, c.task, c.spec);
   c.skills = read_skills(root.sub("skills"), c.spec);
   c.meta = MetaController(root, c.skills, c.spec.feature_names,
                           [](const std::string& task) { return reference_task_factory(task)()->spec().feature_names; });

@@ -48,17 +48,15 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
     tr.from = find_skill(t, "from", skills);
     tr.to = find_skill(t, "to", skills);
     tr.when = tr.expert_when = read_when(t, features);
-    // 0 stands for an absent key (the pipeline's collect.start_states; no cap), not a value.
-    tr.start_states = t.get<int>("start_states", 0, Range::non_negative());
-    if (t.has("start_states") && tr.start_states == 0) throw t.error("start_states", "must be positive");
-    tr.max_steps = t.get<int>("max_steps", 0, Range::non_negative());
-    if (t.has("max_steps") && tr.max_steps == 0) throw t.error("max_steps", "must be positive");
+    // The default 0 stands for an absent key (the pipeline's collect.start_states; no cap):
+    // a default is not range-checked, a value written is.
+    tr.start_states = t.get<int>("start_states", 0, Range::positive());
+    tr.max_steps = t.get<int>("max_steps", 0, Range::positive());
     if (t.has("training")) {
       Section w = t.sub("training");
       if (!w.has("when") && !w.has("max_steps")) throw t.error("training", "give its window: when and/or max_steps");
       if (w.has("when")) tr.training_when = read_when(w, features);
-      tr.training_max_steps = w.get<int>("max_steps", 0, Range::non_negative());
-      if (w.has("max_steps") && tr.training_max_steps == 0) throw w.error("max_steps", "must be positive");
+      tr.training_max_steps = w.get<int>("max_steps", 0, Range::positive());
     } else {
       tr.training_when = tr.when, tr.training_max_steps = tr.max_steps;
     }
@@ -80,8 +78,7 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
           throw e.error("task", err.what());
         }
         tr.expert_when = read_when(e, own);
-        tr.expert_steps = e.get<int>("steps", 0, Range::non_negative());
-        if (e.has("steps") && tr.expert_steps == 0) throw e.error("steps", "must be positive");
+        tr.expert_steps = e.get<int>("steps", 0, Range::positive());
       }
     }
     for (const Transition& other : transitions_)

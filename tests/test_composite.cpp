@@ -284,11 +284,11 @@ TEST(MetaController, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
     MetaController(zero.root(), skills, {"ceiling_ahead"});
     ADD_FAILURE() << "max_steps 0 was accepted";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), "r.yaml: key 'transitions.0.max_steps': must be positive");
+    EXPECT_EQ(std::string(e.what()), "r.yaml: key 'transitions.0.max_steps' must be > 0, got 0");
   }
   refused("{task: walker_crawl}", "r.yaml: key 'transitions.0.expert.task': give pi_b's window on it: expert.steps "
                                   "and/or expert.when (over its features)");
-  refused("{task: walker_crawl, steps: 0}", "r.yaml: key 'transitions.0.expert.steps': must be positive");
+  refused("{task: walker_crawl, steps: 0}", "r.yaml: key 'transitions.0.expert.steps' must be > 0, got 0");
   refused("{task: walker_crawl, steps: 9, when: {ceiling_ahead: [0, 1]}}",
           "r.yaml: key 'transitions.0.expert.when.ceiling_ahead': the task has no feature 'ceiling_ahead' "
           "(features: steps, ceiling_behind)");

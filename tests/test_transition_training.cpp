@@ -616,7 +616,7 @@ TEST_F(TransitionTraining, ATransitionsOwnStartStatesOverrideTheCollectSize) {
     tiny({"transitions.0.start_states=0"});
     FAIL();
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("key 'transitions.0.start_states': must be positive"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("key 'transitions.0.start_states' must be > 0, got 0"), std::string::npos)
         << e.what();
   }
 }
