@@ -99,9 +99,13 @@ int collect_shared(const Distributed& group, const std::string& file, int count,
 
 // Returns the signal number when stopped (nothing of the unfinished set is kept), else 0.
 int collect(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
-            const std::atomic<int>* stop, const Distributed& group, int threads) {
+            const std::atomic<int>* stop, const Distributed& group, int threads, JobPlan& plan) {
   const CollectConfig& c = r.pipeline.collect;
-  if (!group.any(group.leader() && exists(dir + "/start_states.pt"))) {
+  const std::string name = r.transition_name(t);
+  if (group.any(group.leader() && exists(dir + "/start_states.pt"))) {
+    plan.skip(name + " S_a");
+  } else {
+    plan.begin(name + " S_a");
     const int count = r.start_state_count(t);
     spdlog::info("  collecting S_a: {} states where the interval begins", count);
     const auto trained = load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false);
@@ -111,7 +115,10 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
             load_start_states))
       return sig;
   }
-  if (!group.any(group.leader() && exists(dir + "/demonstrations.pt"))) {
+  if (group.any(group.leader() && exists(dir + "/demonstrations.pt"))) {
+    plan.skip(name + " T_b");
+  } else {
+    plan.begin(name + " T_b");
     const Transition& tr = r.meta.transitions()[t];
     if (tr.expert_after_handover)
       spdlog::info("  collecting T_b: at most {} steps of pi_b in its window, taking over at S_a's states",
@@ -250,7 +257,7 @@ int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const Pip
 // With several ranks the attempts are split between them (SwitchTrainer); rank 0 writes
 // and chooses the margin while the others wait.
 int train_switch(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
-                 const std::atomic<int>* stop, const Distributed& group) {
+                 const std::atomic<int>* stop, const Distributed& group, JobPlan& plan) {
   const SwitchConfig& cfg = r.pipeline.switching;
   SwitchTrainer trainer(cfg, r, t, starts_of(r, t, dir), Policy::load(dir + "/policy.pt"),
                         load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false),
@@ -261,6 +268,7 @@ int train_switch(const CompositeRecipe& r, int t, const std::string& run, const 
     trainer.load(ckpt);
     spdlog::info("  resuming from attempt {}", trainer.attempts_done());
   }
+  const double resumed_at = double(trainer.attempts_done()) / cfg.attempts;
   std::optional<MetricsCsv> csv;
   if (group.leader())
     csv.emplace(dir + "/switch.csv",
@@ -272,8 +280,10 @@ int train_switch(const CompositeRecipe& r, int t, const std::string& run, const 
     if (csv)
       csv->write({double(trainer.attempts_done()), s.epsilon, s.success_rate, s.switch_step, s.loss,
                   double(trainer.env_steps()), trainer.wall_seconds(), double(s.replay_rows), double(s.rank0_rows)});
-    spdlog::info("  q_ab: {}/{} attempts, epsilon {:.2f}, pi_b succeeded in {:.0f}%, switch at step {:.1f}",
-                 trainer.attempts_done(), cfg.attempts, s.epsilon, 100 * s.success_rate, s.switch_step);
+    plan.report(double(trainer.attempts_done()) / cfg.attempts, resumed_at, NAN);
+    spdlog::info("  q_ab: {}/{} attempts, epsilon {:.2f}, pi_b succeeded in {:.0f}%, switch at step {:.1f}  job ETA ~{}",
+                 trainer.attempts_done(), cfg.attempts, s.epsilon, 100 * s.success_rate, s.switch_step,
+                 format_duration(plan.eta_seconds()));
     trainer.save(ckpt);
     const int sig = agreed_stop(group, stop);
     if (sig && trainer.attempts_done() < cfg.attempts) return sig;
@@ -343,6 +353,35 @@ void write_actions(const CompositeRecipe& r, int t, const std::string& dir, int 
   write_file_atomic(dir + "/actions.csv", csv.str());
 }
 
+// The job's cost model: seconds per unit of each part on the 2-core VM the main job was
+// measured on (tools/main_job.sh, experiments/hurdle.yaml; README, "Set-up"). Elsewhere,
+// and for other tasks, the parts' own times here rescale it (JobPlan).
+struct Costs {
+  double start_state = 0.14;           // S_a: per state (an episode's walk to the interval)
+  double demonstration_step = 0.0017;  // T_b: per step of pi_b kept
+  double airl_step = 0.00055;          // pi_ab: per PPO step, D included
+  double switch_attempt = 0.032;       // q_ab: per attempt, the margin's check included
+  double lee_step = 0.0015;            // Lee et al.: per PPO step, pi_b's run after each hand-over included
+  double eval_episode = 0.5;           // per episode of a method
+};
+
+// Every part of the run, in the order the stages run them.
+void plan_job(const CompositeRecipe& r, JobPlan& plan) {
+  const Costs c;
+  const int n = int(r.meta.transitions().size());
+  const PipelineConfig& p = r.pipeline;
+  for (int t = 0; t < n; ++t) {
+    plan.add(r.transition_name(t) + " S_a", c.start_state * r.start_state_count(t));
+    plan.add(r.transition_name(t) + " T_b", c.demonstration_step * p.collect.demonstrations);
+    plan.add(r.transition_name(t) + " pi_ab", c.airl_step * double(p.transition.ppo.total_steps));
+  }
+  for (int t = 0; t < n; ++t) plan.add(r.transition_name(t) + " q_ab", c.switch_attempt * p.switching.attempts);
+  for (int t = 0; t < n && p.lee.enabled; ++t)
+    plan.add(r.transition_name(t) + " Lee", c.lee_step * double(p.transition.ppo.total_steps));
+  const int runs = int(method_names().size() * r.eval_seeds.size());
+  plan.add("evaluate", c.eval_episode * runs * r.eval_episodes, runs);
+}
+
 }  // namespace
 
 int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
@@ -353,14 +392,20 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
   const int n = int(recipe.meta.transitions().size());
   const bool lee = recipe.pipeline.lee.enabled;
   const int stages = (lee ? 4 : 3) * n + 1;
+  JobPlan plan;
+  plan_job(recipe, plan);
   int stage = 0;
-  auto announce = [&](const std::string& what) { spdlog::info("[stage {}/{}] {}", ++stage, stages, what); };
-  // Runs a training stage unless its output exists; the signal number if it was stopped.
-  auto stage_unless_done = [&](const std::string& output, const std::function<int()>& train) {
+  auto announce = [&](const std::string& what) {
+    spdlog::info("[stage {}/{}] {}  (job: {})", ++stage, stages, what, plan.summary());
+  };
+  // Runs a training stage (the plan's `part`) unless its output exists; the signal number if it was stopped.
+  auto stage_unless_done = [&](const std::string& part, const std::string& output, const std::function<int()>& train) {
     if (group.any(group.leader() && exists(output))) {
       spdlog::info("  done already: {}", output);
+      plan.skip(part);
       return 0;
     }
+    plan.begin(part);
     int stop = train();
     if (stop) spdlog::warn("interrupted: rerun the same command to resume from the stage's last checkpoint");
     return stop;
@@ -372,32 +417,36 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
     if (group.leader()) fs::create_directories(tdir(t));
     group.leader_done("the transition's folder");
     announce(recipe.transition_name(t) + ": collect S_a and T_b");
-    if (int stop = collect(recipe, t, run, tdir(t), o.stop, group, o.threads)) {
+    if (int stop = collect(recipe, t, run, tdir(t), o.stop, group, o.threads, plan)) {
       spdlog::warn("interrupted: rerun the same command to resume (this collection starts over)");
       return stop;
     }
     announce(recipe.transition_name(t) + ": transition policy (AIRL, Algorithm 1)");
-    if (int stop = stage_unless_done(tdir(t) + "/policy.pt", [&] { return train_transition(recipe, t, tdir(t), o); }))
+    if (int stop = stage_unless_done(recipe.transition_name(t) + " pi_ab", tdir(t) + "/policy.pt",
+                                     [&] { return train_transition(recipe, t, tdir(t), o); }))
       return stop;
   }
   for (int t = 0; t < n; ++t) {
     announce(recipe.transition_name(t) + ": switch Q-network (double DQN, Algorithm 2)");
-    if (int stop = stage_unless_done(tdir(t) + "/q.pt",
-                                     [&] { return train_switch(recipe, t, run, tdir(t), o.stop, group); }))
+    if (int stop = stage_unless_done(recipe.transition_name(t) + " q_ab", tdir(t) + "/q.pt",
+                                     [&] { return train_switch(recipe, t, run, tdir(t), o.stop, group, plan); }))
       return stop;
   }
   for (int t = 0; t < n && lee; ++t) {
     announce(recipe.transition_name(t) + ": Lee et al. 2019 baseline (proximity reward, termination head)");
-    if (int stop = stage_unless_done(tdir(t) + "/lee.pt", [&] { return train_lee(recipe, t, tdir(t), o); }))
+    if (int stop = stage_unless_done(recipe.transition_name(t) + " Lee", tdir(t) + "/lee.pt",
+                                     [&] { return train_lee(recipe, t, tdir(t), o); }))
       return stop;
   }
   if (!group.leader()) return 0;  // rank 0 evaluates
   announce("evaluate every method");
+  plan.begin("evaluate");
   for (int t = 0; t < n; ++t)
     if (!exists(tdir(t) + "/actions.csv")) write_actions(recipe, t, tdir(t));
   const std::string table = run + "/" + recipe.task + ".json";
   if (exists(table)) {
     spdlog::info("  done already: {} (remove it to measure again)", table);
+    plan.end();
     return 0;
   }
   CompositeRecipe trained = recipe;
@@ -411,6 +460,8 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
     write_results(trained, results, skipped, o.command, o.publish_dir);
     spdlog::info("  wrote {}/{}.md and .json", o.publish_dir, recipe.task);
   }
+  plan.end();
+  spdlog::info("job done: {} in this run", format_duration(plan.elapsed_seconds()));
   return 0;
 }
 

@@ -283,8 +283,15 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
     if (total_steps > 0) ov["ppo"]["total_steps"] = total_steps;
     return recipe.with_overrides(ov, recipe.file() + " (stage " + stages[i].name + ")");
   };
-  // Every stage is read and checked before the first step of the first.
-  for (size_t i = 0; i < stages.size(); ++i) read_skill(stage_recipe(i, "(the stage before)", 0), top);
+  // Every stage is read and checked before the first step of the first. The curriculum's
+  // ETA: each stage's line at one rate per step, from 0 where it continues a checkpoint.
+  JobPlan plan;
+  int64_t line_end = 0;
+  for (size_t i = 0; i < stages.size(); ++i) {
+    const int64_t steps = read_skill(stage_recipe(i, "(the stage before)", 0), top).ppo.total_steps;
+    line_end = i == 0 || stages[i].from_policy ? steps : line_end + steps;
+    plan.add(stages[i].name, 1e-3 * double(line_end));
+  }
   if (check_only) return std::printf("%s: ok (%zu stages)\n", recipe.file().c_str(), stages.size()) < 0;
   // With several ranks, rank 0's files decide (which stages are done, their steps).
   const Distributed& group = Distributed::world();
@@ -293,6 +300,7 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
     const std::string dir = stage_dir(top, i, stages[i]);
     if (group.any(group.leader() && std::filesystem::exists(dir + "/eval.json"))) {
       spdlog::info("stage {}/{} '{}' is done ({})", i + 1, stages.size(), stages[i].name, dir);
+      plan.skip(stages[i].name);
       continue;
     }
     std::string start;
@@ -306,7 +314,9 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
                 SkillRecipe::read(stage_recipe(i, start, 0), top).ppo.total_steps;
     }
     const Recipe r = stage_recipe(i, start, total);
-    spdlog::info("stage {}/{} '{}' in {}", i + 1, stages.size(), stages[i].name, dir);
+    spdlog::info("stage {}/{} '{}' in {}  (curriculum: {})", i + 1, stages.size(), stages[i].name, dir,
+                 plan.summary());
+    plan.begin(stages[i].name);
     const int rc = train_skill(r, read_skill(r, top));
     if (group.leader()) write_stage_metrics(top, stages);
     if (rc != 0) return rc;
