@@ -91,14 +91,18 @@ StepResult WalkerPatrol::evaluate(const float* action) {
   double v = x_velocity();
   r.reward = walk_reward(direction_ * v, action, 1.0, 1.0);
   ++since_turn_;
-  if (direction_ * torso_x() > pcfg_.stone_x) {  // passed the target stone
+  bool too_slow = false;
+  if (direction_ * torso_x() > pcfg_.stone_x && direction_ * v < pcfg_.min_pass_speed) {
+    too_slow = true;
+  } else if (direction_ * torso_x() > pcfg_.stone_x) {  // passed the target stone
     ++turns_;
     r.reward += pcfg_.turn_bonus;
     direction_ = -direction_;
     since_turn_ = 0;
     turn_x_ = torso_x();
   }
-  r.terminated = fallen() || turns_ >= pcfg_.max_turns;
+  const bool leg_too_long = pcfg_.max_leg_steps > 0 && since_turn_ >= pcfg_.max_leg_steps;
+  r.terminated = fallen() || turns_ >= pcfg_.max_turns || too_slow || leg_too_long;
   r.info.success = turns_ >= pcfg_.max_turns;
   r.info.success_count = turns_;
   r.info.metrics[0] = v;

@@ -44,12 +44,18 @@ class WalkerCourse : public WalkerObstacleEnv {
 // Patrol: touch the stones at +-stone_x alternately. A turn counts when the torso passes
 // the target stone in the current direction; the direction then flips. Starts in a
 // random direction. Observation: the 26 walker numbers + (target stone x - torso x).
+// Optionally the reference code's speed and leg-length rules (Config).
 class WalkerPatrol : public WalkerEnv {
  public:
   struct Config {
     double stone_x = 2.0;
     int max_turns = 5;
     double turn_bonus = 10.0;
+    // The reference code's rules (off by default, as in the paper's text and our tables):
+    // a stone passed slower than this ends the episode, the turn not counted (its value 2
+    // m/s); a leg (from the start or a turn to the next turn) of more control steps ends it (800).
+    double min_pass_speed = 0.0;
+    int max_leg_steps = 0;  // 0: no limit
   };
   WalkerPatrol(const std::string& name, const WalkerConfig& w, const Config& c);
 

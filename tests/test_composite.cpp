@@ -12,14 +12,15 @@ namespace {
 
 const float kZero[6] = {0, 0, 0, 0, 0, 0};
 
-// Teleports the walker to torso x and takes one step with zero action, upright.
-StepResult step_at(Env& env, double x, std::vector<float>& obs) {
+// Teleports the walker to torso x (moving at vx) and takes one step with zero action, upright.
+StepResult step_at(Env& env, double x, std::vector<float>& obs, double vx = 0) {
   auto& m = dynamic_cast<MujocoEnv&>(env);
   m.mutable_data()->qpos[0] = x;
   m.mutable_data()->qpos[1] = 1.25;
   m.mutable_data()->qpos[2] = 0;
   for (int i = 3; i < 9; ++i) m.mutable_data()->qpos[i] = 0;  // standing straight
   for (int i = 0; i < 9; ++i) m.mutable_data()->qvel[i] = 0;
+  m.mutable_data()->qvel[0] = vx;
   m.forward(obs.data());
   return env.step(kZero, obs.data());
 }
@@ -121,6 +122,33 @@ TEST(Patrol, CountsATurnOncePerStoneAndFlipsDirection) {
   r = step_at(*env, -2.1, obs);
   EXPECT_EQ(r.info.success_count, 2);
   EXPECT_EQ(patrol.direction(), 1);
+}
+
+// The reference code's rules: a stone passed below 2 m/s ends the episode uncounted; a
+// leg of 800 steps ends it. Off by default (the first test above passes at rest).
+TEST(Patrol, TheReferenceRulesEndASlowPassAndALongLeg) {
+  auto env = make_task("patrol", "{push_prob: 0, min_pass_speed: 2, max_leg_steps: 800}");
+  auto& patrol = dynamic_cast<WalkerPatrol&>(*env);
+  std::vector<float> obs(27);
+  uint64_t seed = 0;
+  do env->reset(++seed, obs.data());
+  while (patrol.direction() != 1);
+  StepResult r = step_at(*env, 2.2, obs, 2.5);  // fast enough: a turn
+  EXPECT_EQ(r.info.success_count, 1);
+  EXPECT_FALSE(r.done());
+  r = step_at(*env, -2.1, obs, -1.5);  // 1.5 m/s towards the stone: too slow
+  EXPECT_TRUE(r.terminated);
+  EXPECT_EQ(r.info.success_count, 1);
+  EXPECT_FALSE(r.info.success);
+
+  env->reset(seed, obs.data());  // forward again; the leg's 800th step ends the episode
+  for (int t = 1; t < 800; ++t) {
+    r = step_at(*env, 0.0, obs);
+    ASSERT_FALSE(r.done()) << "step " << t;
+  }
+  r = step_at(*env, 0.0, obs);
+  EXPECT_TRUE(r.terminated);
+  EXPECT_EQ(r.info.success_count, 0);
 }
 
 // The reference's composite tasks apply no pushes (prob_apply_force 0); its sub-tasks push
