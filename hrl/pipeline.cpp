@@ -357,10 +357,10 @@ void write_actions(const CompositeRecipe& r, int t, const std::string& dir, int 
 // measured on (tools/main_job.sh, experiments/hurdle.yaml; README, "Set-up"). Elsewhere,
 // and for other tasks, the parts' own times here rescale it (JobPlan).
 struct Costs {
-  double start_state = 0.14;           // S_a: per state (an episode's walk to the interval)
+  double start_state = 0.27;           // S_a: per state (the walk to the interval: 0.12 s first, 0.43 s second)
   double demonstration_step = 0.0017;  // T_b: per step of pi_b kept
-  double airl_step = 0.00055;          // pi_ab: per PPO step, D included
-  double switch_attempt = 0.032;       // q_ab: per attempt, the margin's check included
+  double airl_step = 0.00036;          // pi_ab: per PPO step, D included
+  double switch_attempt = 0.09;        // q_ab: per attempt, the margin's check included
   double lee_step = 0.0015;            // Lee et al.: per PPO step, pi_b's run after each hand-over included
   double eval_episode = 0.5;           // per episode of a method
 };
