@@ -25,6 +25,14 @@ StepResult step_at(Env& env, double x, std::vector<float>& obs, double vx = 0) {
   return env.step(kZero, obs.data());
 }
 
+// Resets Patrol with the first seed that starts forward, for a readable script; returns it.
+uint64_t reset_forward(Env& env, std::vector<float>& obs) {
+  uint64_t seed = 0;
+  do env.reset(++seed, obs.data());
+  while (dynamic_cast<WalkerPatrol&>(env).direction() != 1);
+  return seed;
+}
+
 }  // namespace
 
 TEST(Hurdle, CountsEachCurbOnceAtOnePointFiveMetresPastItsEnd) {
@@ -103,10 +111,7 @@ TEST(Patrol, CountsATurnOncePerStoneAndFlipsDirection) {
   auto env = make_task("patrol", "{push_prob: 0}");
   auto& patrol = dynamic_cast<WalkerPatrol&>(*env);
   std::vector<float> obs(27);
-  // Find a seed that starts forward, for a readable script.
-  uint64_t seed = 0;
-  do env->reset(++seed, obs.data());
-  while (patrol.direction() != 1);
+  reset_forward(*env, obs);
   EXPECT_NEAR(obs[26], 2.0 - patrol.torso_x(), 1e-6);  // signed distance to the +2 stone
   StepResult r = step_at(*env, 1.5, obs);
   EXPECT_EQ(r.info.success_count, 0);
@@ -128,11 +133,8 @@ TEST(Patrol, CountsATurnOncePerStoneAndFlipsDirection) {
 // leg of 800 steps ends it. Off by default (the first test above passes at rest).
 TEST(Patrol, TheReferenceRulesEndASlowPassAndALongLeg) {
   auto env = make_task("patrol", "{push_prob: 0, min_pass_speed: 2, max_leg_steps: 800}");
-  auto& patrol = dynamic_cast<WalkerPatrol&>(*env);
   std::vector<float> obs(27);
-  uint64_t seed = 0;
-  do env->reset(++seed, obs.data());
-  while (patrol.direction() != 1);
+  const uint64_t seed = reset_forward(*env, obs);
   StepResult r = step_at(*env, 2.2, obs, 2.5);  // fast enough: a turn
   EXPECT_EQ(r.info.success_count, 1);
   EXPECT_FALSE(r.done());
