@@ -1,6 +1,7 @@
 #include "core/progress.h"
 
 #include <algorithm>
+#include <atomic>
 
 #include <unistd.h>
 
@@ -61,7 +62,8 @@ void Progress::finish() {
 }
 
 namespace {
-JobPlan* current_plan = nullptr;
+// One plan per process, fed from the thread that drives the job (Progress lines are too).
+std::atomic<JobPlan*> current_plan{nullptr};
 }
 
 double JobPlan::steady_seconds() {
@@ -70,9 +72,10 @@ double JobPlan::steady_seconds() {
 
 JobPlan::JobPlan(Clock now) : now_(std::move(now)), t0_(now_()) { current_plan = this; }
 JobPlan::~JobPlan() {
-  if (current_plan == this) current_plan = nullptr;
+  JobPlan* self = this;
+  current_plan.compare_exchange_strong(self, nullptr);
 }
-JobPlan* JobPlan::current() { return current_plan; }
+JobPlan* JobPlan::current() { return current_plan.load(); }
 
 void JobPlan::add(std::string part, double seconds, int pieces) {
   parts_.push_back({std::move(part), std::max(0.0, seconds), std::max(1, pieces)});
