@@ -276,7 +276,24 @@ void merge_into(YAML::Node base, const YAML::Node& over) {
     else base[key] = YAML::Clone(kv.second);
   }
 }
+// Adds to `base` what it lacks of `from`: the reverse of merge_into.
+void fill_into(YAML::Node base, const YAML::Node& from) {
+  for (const auto& kv : from) {
+    const std::string key = kv.first.Scalar();
+    YAML::Node mine = base[key];
+    if (!mine.IsDefined() || mine.IsNull()) base[key] = YAML::Clone(kv.second);
+    else if (mine.IsMap() && kv.second.IsMap()) fill_into(mine, kv.second);
+  }
+}
 }  // namespace
+
+Section Section::filled_from(const Section& base) const {
+  auto mine = lookup(prefix_);
+  auto theirs = base.prefix_.empty() ? std::optional<YAML::Node>(base.s_->tree) : base.lookup(base.prefix_);
+  if (!mine || !mine->IsMap()) throw Error(s_->file + ": key '" + prefix_ + "' should be a mapping of keys");
+  if (theirs && theirs->IsMap()) fill_into(*mine, *theirs);
+  return *this;
+}
 
 std::vector<YAML::Node> Recipe::stages() const {
   std::vector<YAML::Node> out;

@@ -66,6 +66,10 @@ class Section {
   std::vector<std::string> keys() const;
   // The mappings of the sequence `key` (absent: none), each a Section "key.i".
   std::vector<Section> items(const std::string& key) const;
+  // This mapping with the keys it leaves out filled in from `base` as written there
+  // (mappings key by key): a variant of another section, read in full at its own keys, e.g.
+  // a transition's training env over the recipe's `env:`.
+  Section filled_from(const Section& base) const;
   const std::string& path() const { return prefix_; }
   // "FILE: key 'a.b': msg" — the one-line error for a bad value found after reading.
   Error error(const std::string& key, const std::string& msg) const;

@@ -52,7 +52,7 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
   };
   std::vector<Worker> workers(size_t(std::max(1, threads)));
   for (auto& w : workers) {
-    w.env = r.make_env();
+    w.env = r.training_envs.at(transition)();
     w.controller.emplace(r.skills, r.meta, trained, any_q ? SwitchRule::QNetwork : SwitchRule::IntervalEnd);
     w.obs.resize(w.env->spec().obs_dim), w.act.resize(w.env->spec().act_dim);
   }
@@ -126,7 +126,7 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
   };
   std::vector<Worker> workers(size_t(std::max(1, threads)));
   for (auto& w : workers) {
-    w.env = own_task ? reference_task_factory(tr.expert_task)() : r.make_env();
+    w.env = own_task ? reference_task_factory(tr.expert_task)() : r.training_envs.at(transition)();
     w.b = b;
     w.obs.resize(w.env->spec().obs_dim), w.act.resize(w.env->spec().act_dim), w.prev.resize(D);
     w.f.resize(w.env->spec().feature_names.size());

@@ -11,6 +11,8 @@
 //        a window). Observations are in pi_b's slice of the task observation. With
 //        `expert.after_handover`, episodes start instead at S_a's states, one each, and
 //        T_b is as large as they give (at most `count`).
+// Both are collected in the transition's training env (its `training.env`; by default the
+// task as evaluated), e.g. with the sub-tasks' random pushes as the reference collects them.
 // Both are stored as tensors in a .pt file (torch.load-able) that later stages read back,
 // with the task and transition they were collected for (`source`), so a file copied into
 // another transition's folder is refused rather than trained on.

@@ -24,6 +24,19 @@ CompositeRecipe CompositeRecipe::load(const std::string& file, const std::vector
                           [](const std::string& task) { return reference_task_factory(task)()->spec().feature_names; });
   const auto items = root.items("transitions");
   for (size_t t = 0; t < c.meta.transitions().size(); ++t) {
+    Section training = items[t].sub("training");
+    if (!training.has("env")) {
+      c.training_envs.push_back(c.make_env);
+      continue;
+    }
+    training.sub("env").filled_from(root.sub("env"));
+    EnvSpec spec;
+    c.training_envs.push_back(read_task(training, c.task, spec));
+    if (spec.obs_dim != c.spec.obs_dim || spec.act_dim != c.spec.act_dim || spec.feature_names != c.spec.feature_names)
+      throw training.error("env", "changes the task's observations, actions or features; it may change only how "
+                                  "episodes run (pushes, noise, rules)");
+  }
+  for (size_t t = 0; t < c.meta.transitions().size(); ++t) {
     const Transition& tr = c.meta.transitions()[t];
     if (tr.expert_task.empty()) continue;
     Section e = items[t].sub("expert");

@@ -36,6 +36,10 @@ struct CompositeRecipe {
   EnvSpec spec;
   std::vector<Skill> skills;
   MetaController meta;
+  // Per transition, where its S_a and T_b are collected and pi_ab trains: the task with the
+  // transition's `training.env` laid over `env:` (the reference collects and trains in the
+  // sub-tasks' environments, with their pushes); make_env where it has none.
+  std::vector<EnvFactory> training_envs;
   std::string single_policy;    // methods.single.policy ("" when absent)
   std::string transitions_dir;  // methods.transitions ("" when absent)
   PipelineConfig pipeline;

@@ -52,11 +52,12 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
     // a default is not range-checked, a value written is.
     tr.start_states = t.get<int>("start_states", 0, Range::positive());
     tr.max_steps = t.get<int>("max_steps", 0, Range::positive());
-    if (t.has("training")) {
-      Section w = t.sub("training");
-      if (!w.has("when") && !w.has("max_steps")) throw t.error("training", "give its window: when and/or max_steps");
+    Section w = t.sub("training");
+    if (w.has("when") || w.has("max_steps")) {
       if (w.has("when")) tr.training_when = read_when(w, features);
       tr.training_max_steps = w.get<int>("max_steps", 0, Range::positive());
+    } else if (t.has("training") && !w.has("env")) {
+      throw t.error("training", "give its window (when and/or max_steps) or its env");
     } else {
       tr.training_when = tr.when, tr.training_max_steps = tr.max_steps;
     }

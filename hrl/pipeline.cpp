@@ -201,7 +201,7 @@ int train_transition(const CompositeRecipe& r, int t, const std::string& dir, co
   StartStates starts = starts_of(r, t, dir);
   const Shard share = o.group->shard(cfg.ppo.num_envs, "transition.ppo.num_envs");
   VectorEnv envs(
-      [&] { return std::make_unique<TransitionEnv>(r.make_env(), starts, tr.training_window(), b.obs_begin, b.obs_end); },
+      [&] { return std::make_unique<TransitionEnv>(r.training_envs[t](), starts, tr.training_window(), b.obs_begin, b.obs_end); },
       share.count, o.threads, share.first);
   TransitionPolicyTrainer trainer(cfg, envs, demonstrations_of(r, t, dir), b.policy,
                                   mix_seed(r.pipeline.seed, 100 + t), *o.group);

@@ -71,7 +71,7 @@ class CollectionFiles : public TempDirTest {
   CompositeRecipe hurdle_with_stage13_jump(const std::string& expert_extra) {
     std::ifstream in(CompositeRecipe::default_file("hurdle"));
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    const std::string expert = "expert: {successful: true";
+    const std::string expert = "successful: true";  // walk -> jump's expert section
     const std::string shipped = "jump: {policy: assets/policies/walker/walker_jump.pt}";
     if (text.find(expert) == std::string::npos || text.find(shipped) == std::string::npos)
       throw Error("hurdle.yaml no longer has '" + expert + "' and '" + shipped + "'");
@@ -260,7 +260,7 @@ TEST(Collection, DemonstrationsFromTheSkillsOwnTaskAreItsFirstSteps) {
 }
 
 // expert.successful: T_b keeps only the windows after which pi_b succeeds. On Hurdle's
-// walk -> jump the window is 3-4 m before the first curb and success is clearing it;
+// walk -> jump the window is 2-4 m before the first curb and success is clearing it;
 // the expected T_b is rebuilt by replaying each episode of the jump by hand.
 TEST_F(CollectionFiles, SuccessfulDemonstrationsAreTheWindowsPiBSucceedsFrom) {
   // Stage 13's jump (38%), so that some windows are dropped whatever the shipped jump's rate.
@@ -282,7 +282,7 @@ TEST_F(CollectionFiles, SuccessfulDemonstrationsAreTheWindowsPiBSucceedsFrom) {
     bool entered = false, past = false, cleared = false;
     for (;;) {
       env->features(f.data());
-      bool inside = MetaController::holds(tr.when, f.data());
+      bool inside = MetaController::holds(tr.expert_when, f.data());
       past |= entered && !inside;
       if (past && cleared) break;
       entered |= inside;
@@ -301,6 +301,50 @@ TEST_F(CollectionFiles, SuccessfulDemonstrationsAreTheWindowsPiBSucceedsFrom) {
   EXPECT_EQ(d.obs, want);
   EXPECT_EQ(collect_demonstrations(r, 0, count, 11, kDemonstrationEpisodes, nullptr, nullptr, 2).obs, d.obs)
       << "two threads keep other windows";
+}
+
+// training.env: walk->jump's S_a and T_b come from Hurdle with its settings laid over the
+// recipe's `env:`. Recipe A writes the pushes there; recipe B writes the pushed task as its
+// `env:`: their S_a and T_b are identical, A's training env steps as B's task does, and A's
+// evaluated task (and its other transition) stays without pushes.
+TEST_F(CollectionFiles, ATransitionsTrainingEnvIsTheTaskWithItsSettingsLaidOverEnv) {
+  std::ifstream in(CompositeRecipe::default_file("hurdle"));
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto write = [&](const std::string& name, const std::string& env, const std::string& training) {
+    std::string t = text;
+    ASSERT_NE(t.find("env: {}"), std::string::npos);
+    t.replace(t.find("env: {}"), 7, env);
+    ASSERT_NE(t.find("training: {"), std::string::npos);  // walk -> jump's, the first
+    t.insert(t.find("training: {") + 11, training);
+    std::ofstream(path(name)) << t;
+  };
+  write("a.yaml", "env: {push_force: 50}", "env: {push_prob: 0.3}, ");
+  write("b.yaml", "env: {push_force: 50, push_prob: 0.3}", "");
+  write("typo.yaml", "env: {}", "env: {push_prb: 0.3}, ");
+  CompositeRecipe a = CompositeRecipe::load(path("a.yaml")), b = CompositeRecipe::load(path("b.yaml"));
+
+  auto trace = [](const EnvFactory& make) {
+    auto env = make();
+    std::vector<float> obs(env->spec().obs_dim), act(env->spec().act_dim, 0.1f), out;
+    env->reset(7, obs.data());
+    for (int i = 0; i < 150; ++i) {
+      if (env->step(act.data(), obs.data()).done()) break;
+      out.insert(out.end(), obs.begin(), obs.end());
+    }
+    return out;
+  };
+  EXPECT_EQ(trace(a.training_envs[0]), trace(b.make_env));
+  EXPECT_NE(trace(a.make_env), trace(b.make_env));  // the pushes act
+  EXPECT_EQ(trace(a.training_envs[1]), trace(a.make_env));
+
+  StartStates sa = collect_start_states(a, 0, 8, 4), sb = collect_start_states(b, 0, 8, 4);
+  EXPECT_EQ(sa.states, sb.states);
+  EXPECT_EQ(collect_demonstrations(a, 0, 200, 5).obs, collect_demonstrations(b, 0, 200, 5).obs);
+  EXPECT_NE(collect_start_states(a, 1, 4, 4).states, collect_start_states(b, 1, 4, 4).states);
+
+  expect_error([&] { CompositeRecipe::load(path("typo.yaml")); },
+               "typo.yaml: unknown key 'transitions.0.training.env.push_prb'; did you mean "
+               "'transitions.0.training.env.push_prob'?");
 }
 
 TEST_F(CollectionFiles, ExpertWindowsAreCheckedAtLoadAndAfterAThousandEmptyEpisodes) {
@@ -330,7 +374,7 @@ TEST_F(CollectionFiles, ExpertWindowsAreCheckedAtLoadAndAfterAThousandEmptyEpiso
 // expert.after_handover: T_b is pi_b's window from each S_a state it is given, once each;
 // with expert.successful only those after which pi_b clears the curb it took over for
 // (also at later curbs, where the episode's count is already above 0). Rebuilt by hand:
-// restore each state, run the jump while the interval holds, then on to its next success.
+// restore each state, run the jump while T_b's window (expert.when) holds, then on to its next success.
 TEST_F(CollectionFiles, DemonstrationsAfterTheHandOverStartAtSaAndKeepTheWindowsPiBSucceedsFrom) {
   CompositeRecipe r = hurdle_with_stage13_jump(", after_handover: true");
   const Transition& tr = r.meta.transitions()[0];
@@ -354,7 +398,7 @@ TEST_F(CollectionFiles, DemonstrationsAfterTheHandOverStartAtSaAndKeepTheWindows
     bool past = false, cleared = false;
     for (;;) {
       env->features(f.data());
-      past |= !MetaController::holds(tr.when, f.data());
+      past |= !MetaController::holds(tr.expert_when, f.data());
       if (past && cleared) break;
       if (!past) window.insert(window.end(), obs.begin() + jump.obs_begin, obs.begin() + jump.obs_end);
       jump.policy.act(obs.data() + jump.obs_begin, 1, act.data());

@@ -352,8 +352,15 @@ TEST(MetaController, ATrainingWindowApartFromTheInterval) {
     MetaController(empty.root(), skills, {"curb_ahead"});
     ADD_FAILURE() << "an empty training window was accepted";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), "r.yaml: key 'transitions.0.training': give its window: when and/or max_steps");
+    EXPECT_EQ(std::string(e.what()),
+              "r.yaml: key 'transitions.0.training': give its window (when and/or max_steps) or its env");
   }
+  // A training env alone keeps the interval as the window.
+  Recipe pushed = Recipe::parse(head + ", max_steps: 50, training: {env: {push_prob: 0.2}}}", "r.yaml");
+  const Transition e = MetaController(pushed.root(), skills, {"curb_ahead"}).transitions()[0];
+  ASSERT_EQ(e.training_when.size(), 1u);
+  EXPECT_EQ(e.training_when[0].lo, 3.0);
+  EXPECT_EQ(e.training_max_steps, 50);
 }
 
 }  // namespace segue

@@ -137,7 +137,9 @@ int keys_main(int argc, char** argv) {
 
   std::printf("## Composite recipes (`segue run`, `segue eval --method`)\n\n"
               "Read from each shipped `experiments/TASK.yaml`; `transitions.N` is each transition. The values\n"
-              "shown are the first recipe's (with the code's defaults where it sets none). Task settings as above.\n\n");
+              "shown are the first recipe's (with the code's defaults where it sets none). Task settings as above;\n"
+              "`transitions.N.training.env` (optional) takes the same settings, laid over `env:` where that\n"
+              "transition's S_a and T_b are collected and its pi_ab trains.\n\n");
   Rows composite;
   for (const std::string& task : task_names()) {
     const std::string file = CompositeRecipe::default_file(task);
@@ -145,7 +147,8 @@ int keys_main(int argc, char** argv) {
     const CompositeRecipe c = CompositeRecipe::load(file);
     add_rows(c.resolved, c.key_rules, composite);
   }
-  table(composite, [](const std::string& k) { return !starts(k, "env."); }, "value");
+  table(composite, [](const std::string& k) { return !starts(k, "env.") && k.find(".training.env.") == std::string::npos; },
+        "value");
   return 0;
 }
 
