@@ -55,6 +55,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {
     segue::Recipe r = segue::Recipe::parse(yaml, "fuzz.yaml", sets);
     read_all(r.root(), 0);
+    // A section filled from `env:` (as a transition's training.env is), then read in full.
+    for (const std::string& key : r.root().keys()) {
+      try {
+        read_all(r.root().sub(key).filled_from(r.root().sub("env")), 1);
+      } catch (const segue::Error&) {
+      }
+    }
     r.resolved_yaml();
     for (const auto& stage : r.stages()) {
       try {
