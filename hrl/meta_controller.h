@@ -64,7 +64,7 @@ struct Transition {
   // on past where the switch must hand over, so that pi_ab does not learn to hand over at
   // the very edge of its own episodes (the reference trains Hurdle's walk->jump from 4 to
   // 2 m before the curb and evaluates it from 4 to 3 m; pick->pick until the box lifts off,
-  // where the switch is forced after 30 steps). Its `env:` (CompositeRecipe::training_env)
+  // where the switch is forced after 30 steps). Its `env:` (CompositeRecipe::training_envs)
   // is where they run.
   std::vector<Condition> training_when;
   int training_max_steps = 0;
