@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <fstream>
-#include <iterator>
 
 #include "core/assets.h"
+#include "core/run_dir.h"
 #include "environments/registry.h"
 #include "hrl/collection.h"
 #include "tests/temp_dir.h"
@@ -69,8 +69,7 @@ class CollectionFiles : public TempDirTest {
   // Hurdle (walk->jump's T_b from the windows the jump succeeds from) with stage 13's 38%
   // jump, and `expert_extra` (", key: value") added to walk->jump's expert.
   CompositeRecipe hurdle_with_stage13_jump(const std::string& expert_extra) {
-    std::ifstream in(CompositeRecipe::default_file("hurdle"));
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::string text = read_file(CompositeRecipe::default_file("hurdle"));
     const std::string expert = "successful: true";  // walk -> jump's expert section
     const std::string shipped = "jump: {policy: assets/policies/walker/walker_jump.pt}";
     if (text.find(expert) == std::string::npos || text.find(shipped) == std::string::npos)
@@ -308,8 +307,7 @@ TEST_F(CollectionFiles, SuccessfulDemonstrationsAreTheWindowsPiBSucceedsFrom) {
 // `env:`: their S_a and T_b are identical, A's training env steps as B's task does, and A's
 // evaluated task (and its other transition) stays without pushes.
 TEST_F(CollectionFiles, ATransitionsTrainingEnvIsTheTaskWithItsSettingsLaidOverEnv) {
-  std::ifstream in(CompositeRecipe::default_file("hurdle"));
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = read_file(CompositeRecipe::default_file("hurdle"));
   auto write = [&](const std::string& name, const std::string& env, const std::string& training) {
     std::string t = text;
     ASSERT_NE(t.find("env: {}"), std::string::npos);
@@ -349,8 +347,7 @@ TEST_F(CollectionFiles, ATransitionsTrainingEnvIsTheTaskWithItsSettingsLaidOverE
 
 TEST_F(CollectionFiles, ExpertWindowsAreCheckedAtLoadAndAfterAThousandEmptyEpisodes) {
   // The crawl run alone on the course falls in the open before any ceiling is 2-3 m ahead.
-  std::ifstream in(CompositeRecipe::default_file("obstacle_course"));
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string text = read_file(CompositeRecipe::default_file("obstacle_course"));
   const std::string expert = ", expert: {task: walker_crawl, steps: 150}";
   ASSERT_NE(text.find(expert), std::string::npos);
   text.erase(text.find(expert), expert.size());
@@ -418,8 +415,7 @@ TEST_F(CollectionFiles, DemonstrationsAfterTheHandOverStartAtSaAndKeepTheWindows
   // Without S_a's states, or with the skill's own task, it is refused.
   expect_error([&] { collect_demonstrations(r, 0, 100, 9); },
                "transition walk-jump: expert.after_handover needs S_a's states");
-  std::ifstream in(CompositeRecipe::default_file("obstacle_course"));
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::string text = read_file(CompositeRecipe::default_file("obstacle_course"));
   const std::string own = "expert: {task: walker_crawl, steps: 150";
   ASSERT_NE(text.find(own), std::string::npos);
   text.insert(text.find(own) + own.size(), ", after_handover: true");
