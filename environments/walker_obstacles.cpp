@@ -26,6 +26,7 @@ ObstacleConfig ObstacleConfig::read(const Section& s, ObstacleConfig c) {
   c.ceiling_far_start = s.get("ceiling_far_start", c.ceiling_far_start, Range::non_negative());
   c.ceiling_far_end = s.get("ceiling_far_end", c.ceiling_far_end, Range::non_negative());
   c.pass_margin = s.get("pass_margin", c.pass_margin, Range::non_negative());
+  c.ceiling_pass_margin = s.get("ceiling_pass_margin", c.ceiling_pass_margin, Range::non_negative());
   c.contact_penalty = s.get("contact_penalty", c.contact_penalty, Range::non_negative());
   c.ceiling_length = s.get("ceiling_length", c.ceiling_length, Range::positive());
   return c;
@@ -137,7 +138,10 @@ bool WalkerObstacleEnv::touching(int kind) const {
 int WalkerObstacleEnv::update_passed() {
   int before = passed_;
   double x = min_x();
-  while (passed_ < int(obstacles_.size()) && x > obstacles_[passed_].end + ocfg_.pass_margin) ++passed_;
+  auto margin = [&](const Obstacle& o) {
+    return o.kind == ObstacleKind::Ceiling ? ocfg_.ceiling_pass_margin : ocfg_.pass_margin;
+  };
+  while (passed_ < int(obstacles_.size()) && x > obstacles_[passed_].end + margin(obstacles_[passed_])) ++passed_;
   return passed_ - before;
 }
 

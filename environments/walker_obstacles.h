@@ -30,6 +30,7 @@ struct ObstacleConfig {
   double curb_far_start = 5.1, curb_far_end = 5.2;
   double ceiling_far_start = 5.1, ceiling_far_end = 6.0;
   double pass_margin = 1.5;      // an obstacle counts as passed when x > end + pass_margin
+  double ceiling_pass_margin = 1.5;  // for a ceiling (the reference code counts it at end + 0.15)
   double contact_penalty = 10.0; // reward on touching an obstacle (the episode ends)
   double curb_width = 0.2;       // curb thickness along x (the model's box is 0.2)
   double ceiling_length = 3.0;   // ceiling length in composite courses

@@ -62,6 +62,26 @@ TEST(Hurdle, CountsEachCurbOnceAtOnePointFiveMetresPastItsEnd) {
   EXPECT_EQ(count, 5);
 }
 
+// The reference code counts a ceiling 0.15 m past its end (ceiling_pass_margin), a curb
+// 1.5 m past (pass_margin); by default both are 1.5.
+TEST(ObstacleCourse, CountsACeilingAtItsOwnPassMargin) {
+  const std::string layout = "{position_noise: 0, push_prob: 0, shuffle: false, kinds: [ceiling, curb, curb, curb, ceiling]";
+  for (double margin : {1.5, 0.15}) {
+    auto env = make_task("obstacle_course", layout + (margin == 1.5 ? "}" : ", ceiling_pass_margin: 0.15}"));
+    auto& course = dynamic_cast<WalkerCourse&>(*env);
+    std::vector<float> obs(28);
+    env->reset(0, obs.data());
+    ASSERT_EQ(course.obstacles()[0].kind, ObstacleKind::Ceiling);
+    ASSERT_DOUBLE_EQ(course.obstacles()[0].end, 11.0);  // 8 + its 3 m
+    // min_x is the torso's x here (upright, feet forward); the ceiling is behind it.
+    EXPECT_EQ(step_at(*env, 11.0 + margin - 0.05, obs).info.success_count, 0) << margin;
+    EXPECT_EQ(step_at(*env, 11.0 + margin + 0.05, obs).info.success_count, 1) << margin;
+    // The next curb (19-19.2) still counts at 1.5 m.
+    EXPECT_EQ(step_at(*env, 20.65, obs).info.success_count, 1) << margin;
+    EXPECT_EQ(step_at(*env, 20.75, obs).info.success_count, 2) << margin;
+  }
+}
+
 TEST(Hurdle, FeaturesAreDistancesToCurbs) {
   auto env = make_task("hurdle", "{position_noise: 0, push_prob: 0}");
   std::vector<float> obs(28);
