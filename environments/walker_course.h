@@ -3,8 +3,8 @@
 // this one class with a different layout (recipe `env:` keys), as the spec describes:
 //   Hurdle:          curbs at 8, 18, ..., 48 (+ U(position_noise))
 //   Obstacle course: 3 curbs and 2 ceilings in random order at 8, 19, ..., 52 (+ U(0.5))
-// An obstacle counts when x is pass_margin past its end (a ceiling: ceiling_pass_margin). The episode ends on a fall, on
-// touching an obstacle, or when every obstacle is passed.
+// An obstacle counts when x is pass_margin past its end (a ceiling: ceiling_pass_margin).
+// The episode ends on a fall, on touching an obstacle, or when every obstacle is passed.
 #include "environments/walker_obstacles.h"
 
 namespace segue {

@@ -65,7 +65,8 @@ TEST(Hurdle, CountsEachCurbOnceAtOnePointFiveMetresPastItsEnd) {
 // The reference code counts a ceiling 0.15 m past its end (ceiling_pass_margin), a curb
 // 1.5 m past (pass_margin); by default both are 1.5.
 TEST(ObstacleCourse, CountsACeilingAtItsOwnPassMargin) {
-  const std::string layout = "{position_noise: 0, push_prob: 0, shuffle: false, kinds: [ceiling, curb, curb, curb, ceiling]";
+  const std::string layout =
+      "{position_noise: 0, push_prob: 0, shuffle: false, kinds: [ceiling, curb, curb, curb, ceiling]";
   for (double margin : {1.5, 0.15}) {
     auto env = make_task("obstacle_course", layout + (margin == 1.5 ? "}" : ", ceiling_pass_margin: 0.15}"));
     auto& course = dynamic_cast<WalkerCourse&>(*env);
