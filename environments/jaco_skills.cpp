@@ -21,6 +21,7 @@ PickRule::Config PickRule::Config::read(const Section& e) {
   c.hold_steps = e.get("hold_steps", c.hold_steps, Range::at_least(1));
   c.time_bonus = e.get("time_bonus", c.time_bonus, Range::non_negative());
   c.center_weight = e.get("center_weight", c.center_weight, Range::non_negative());
+  c.push_weight = e.get("push_weight", c.push_weight, Range::non_negative());
   return c;
 }
 
@@ -36,14 +37,20 @@ void PickRule::begin(const JacoEnv& env) {
   Vec3 box = env.object_pos();
   s.target = {box[0], box[1], cfg.hold_height};
   s.prev_dist = env.hand_object_distance();
+  s.prev_box = box;
 }
 
 RuleStep PickRule::step(const JacoEnv& env, int t, int max_steps) {
   RuleStep r;
   const double d = env.hand_object_distance(), z = env.object_z();
   const bool hand = d < cfg.in_hand, air = z > cfg.in_air;
-  if (!s.picked) r.reward += cfg.guide_weight * (s.prev_dist - d);
+  const Vec3 box = env.object_pos();
+  if (!s.picked) {
+    r.reward += cfg.guide_weight * (s.prev_dist - d) -
+                cfg.push_weight * std::hypot(box[0] - s.prev_box[0], box[1] - s.prev_box[1]);
+  }
   s.prev_dist = d;
+  s.prev_box = box;
   if (hand && air) {
     s.picked = 1;
     const double gain = std::min(cfg.lift_cap, z) - s.pick_height;
@@ -51,7 +58,7 @@ RuleStep PickRule::step(const JacoEnv& env, int t, int max_steps) {
       r.reward += cfg.lift_weight * gain;
       s.pick_height = z;
     }
-    r.reward += cfg.hold_weight * (1 - distance(s.target, env.object_pos())) - cfg.center_weight * d;
+    r.reward += cfg.hold_weight * (1 - distance(s.target, box)) - cfg.center_weight * d;
     s.held += 1;
     if (s.held >= cfg.hold_steps) {
       r.success = true;

@@ -32,11 +32,15 @@ struct PickRule {
     // Not in the reference (0 there): -center_weight |hand - box| on each held step, for a
     // grasp deep in the hand rather than at the edge of in_hand, where the box slips out.
     double center_weight = 0.0;
+    // Not in the reference (0 there): -push_weight |box's horizontal move| on each step
+    // before the pick, for an approach that does not knock the box out of reach.
+    double push_weight = 0.0;
     static Config read(const Section& env);
   };
   struct State {
     double prev_dist = 0, pick_height = 0, held = 0, picked = 0;
     Vec3 target{0, 0, 0};
+    Vec3 prev_box{0, 0, 0};
   };
   Config cfg;
   State s;

@@ -227,6 +227,26 @@ TEST(Jaco, PickRewardsAndSuccessByHand) {
   EXPECT_NEAR(first, plain - 10 * centred->hand_object_distance(), 1e-9);
 }
 
+TEST(Jaco, PickPushWeightCostsTheBoxsHorizontalMoveBeforeThePick) {
+  // The box, still on the ground and far from the hand, is slid 5 cm along x and 3 cm along
+  // y: with push_weight 10 the step costs 10 |its horizontal move| more than without.
+  std::vector<float> obs(49), zero(9, 0.0f);
+  double reward[2], moved = 0;
+  for (int k = 0; k < 2; ++k) {
+    auto env = make_arm<JacoPick>("jaco_pick", k ? "{init_random_steps: 0, push_weight: 10}"
+                                                 : "{init_random_steps: 0}");
+    env->reset(6, obs.data());
+    const Vec3 start = env->object_pos();
+    pin(*env, {start[0] + 0.05, start[1] + 0.03, start[2]}, obs);
+    reward[k] = env->step(zero.data(), obs.data()).reward;
+    const Vec3 p = env->object_pos();
+    moved = std::hypot(p[0] - start[0], p[1] - start[1]);
+    ASSERT_GT(env->hand_object_distance(), 0.06);  // not picked
+  }
+  EXPECT_NEAR(moved, std::hypot(0.05, 0.03), 2e-3);
+  EXPECT_NEAR(reward[1], reward[0] - 10 * moved, 1e-9);
+}
+
 TEST(Jaco, PickFailsWhenTheBoxLeavesTheHandAfterThePick) {
   auto env = make_arm<JacoPick>("jaco_pick", "{init_random_steps: 0}");
   object_contacts_off(*env);
