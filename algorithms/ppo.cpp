@@ -353,6 +353,16 @@ void PPO::init_actor(const Policy& p, float extra_bias) {
   refresh_inference_copy();
 }
 
+void PPO::set_action_bias(int dim, float bias) {
+  if (dim < 0 || dim >= buf_.act_dim) throw Error("set_action_bias: no action dimension " + std::to_string(dim));
+  torch::nn::LinearImpl* last = nullptr;  // the output layer: the actor's last Linear
+  for (auto& m : net_->actor->modules(/*include_self=*/false))
+    if (auto* linear = m->as<torch::nn::Linear>()) last = linear;
+  torch::NoGradGuard no_grad;
+  last->bias[dim].fill_(bias);
+  refresh_inference_copy();
+}
+
 Policy PPO::policy() const {
   const auto& spec = envs_.spec();
   return Policy(actor_copy_, std::vector<float>(obs_rms_.mean().begin(), obs_rms_.mean().end()),

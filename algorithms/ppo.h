@@ -107,6 +107,9 @@ class PPO {
   // see a prefix of the trainer's observation (a walker skill, before the obstacle pair):
   // the other inputs start at zero weight, so the actor begins as exactly that policy.
   void init_actor(const Policy& policy, float extra_bias = 0.0f);
+  // Sets one action dimension's mean bias on an actor left at its random weights, so that
+  // an extra output (Lee et al.'s termination head) starts where init_actor would put it.
+  void set_action_bias(int dim, float bias);
   // Sets every action dimension's log std: a run continued from a converged checkpoint
   // has next to no exploration left (PPO here has no entropy bonus).
   void set_log_std(double log_std);

@@ -577,6 +577,26 @@ TEST_F(TransitionTraining, LeeCheckpointKeepsThePredictorsLabelledStates) {
   EXPECT_EQ(again.ppo().iteration(), 2);
 }
 
+// Lee et al.'s termination head starts at lee.termination_bias also when the policy starts
+// from random weights (transition.init_from_next: false), not at ~0, where sampling would end
+// half the episodes at their first step.
+TEST_F(TransitionTraining, LeeTerminationHeadStartsAtItsBiasFromRandomWeights) {
+  for (const char* init : {"true", "false"}) {
+    CompositeRecipe r = tiny({std::string("transition.init_from_next=") + init, "lee.termination_bias=-0.6"});
+    const Skill& b = r.skills[r.meta.transitions()[0].to];
+    StartStates starts = collect_start_states(r, 0, 4, 1);
+    Demonstrations expert = collect_demonstrations(r, 0, 100, 2);
+    VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r, 0, starts, 500); }, 2, 1);
+    LeeTrainer lee(r.pipeline.transition, r.pipeline.lee, envs, expert, b.policy, 5);
+    const int D = envs.spec().obs_dim, A = envs.spec().act_dim;
+    auto obs = random_obs(16, D, 3);
+    std::vector<float> act(16 * A);
+    lee.policy().act(obs.data(), 16, act.data());
+    // The output layer's weights start at gain 0.01 (from random) or 0 (from pi_b) on it.
+    for (int i = 0; i < 16; ++i) EXPECT_NEAR(act[i * A + A - 1], -0.6, 0.1) << init << " " << i;
+  }
+}
+
 TEST_F(TransitionTraining, LeeEpisodesEndAtTheTerminationOutputWithPiBsOutcome) {
   CompositeRecipe r = tiny();
   StartStates starts = collect_start_states(r, 0, 4, 1);
