@@ -310,7 +310,7 @@ torch::Tensor PPO::log_prob(const float* raw_obs, const float* actions, int64_t 
   return net_->log_prob(net_->mean(obs), act);
 }
 
-void PPO::init_actor(const Policy& p, float extra_bias) {
+void PPO::init_actor(const Policy& p) {
   if (p.obs_dim() > buf_.obs_dim || p.act_dim() > buf_.act_dim)
     throw Error("init_actor: the policy's sizes differ from the trainer's");
   // A policy without features starts a trainer with them at zero weight on the features;
@@ -333,7 +333,7 @@ void PPO::init_actor(const Policy& p, float extra_bias) {
     if (first && linear->weight.size(1) > cols) linear->weight.zero_();
     if (last && linear->weight.size(0) > rows) {
       linear->weight.zero_();
-      linear->bias.fill_(extra_bias);
+      linear->bias.zero_();
     }
     linear->weight.narrow(0, 0, rows).narrow(1, 0, cols).copy_(
         torch::from_blob(const_cast<float*>(ws[layer].data()), {rows, cols}));

@@ -103,12 +103,13 @@ class PPO {
   // Starts the actor from a trained policy (weights and observation normaliser); the log
   // std keeps its initial value. A transition policy can start as pi_b, whose behaviour it
   // is trained to match. The actor may have more outputs than the policy (Lee et al.'s
-  // termination head): those start at zero weight and bias `extra_bias`. The policy may
-  // see a prefix of the trainer's observation (a walker skill, before the obstacle pair):
-  // the other inputs start at zero weight, so the actor begins as exactly that policy.
-  void init_actor(const Policy& policy, float extra_bias = 0.0f);
-  // Sets one action dimension's mean bias on an actor left at its random weights, so that
-  // an extra output (Lee et al.'s termination head) starts where init_actor would put it.
+  // termination head): those start at zero weight and bias (set_action_bias sets one). The
+  // policy may see a prefix of the trainer's observation (a walker skill, before the
+  // obstacle pair): the other inputs start at zero weight, so the actor begins as exactly
+  // that policy.
+  void init_actor(const Policy& policy);
+  // Sets the bias of one action dimension's mean (the output layer's), e.g. where Lee et
+  // al.'s termination head starts, whether the actor began as a policy or at random.
   void set_action_bias(int dim, float bias);
   // Sets every action dimension's log std: a run continued from a converged checkpoint
   // has next to no exploration left (PPO here has no entropy bonus).

@@ -83,12 +83,10 @@ LeeTrainer::LeeTrainer(const TransitionPolicyConfig& tp, const LeeConfig& c, Vec
       ppo_(tp.ppo, tp.network(envs.spec(), next), envs, seed, group),
       obs_dim_(envs.spec().obs_dim) {
   if (expert.obs_dim != obs_dim_) throw Error("Lee transition policy: T_b's observation size differs from pi_b's");
-  // The termination head starts rarely firing either way: from random weights it would end
+  if (tp.init_from_next) ppo_.init_actor(next);
+  // The termination head starts rarely firing either way: at ~0 (random weights) it would end
   // about half the episodes at their first step, each then costing a whole run of pi_b.
-  if (tp.init_from_next)
-    ppo_.init_actor(next, c.termination_bias);
-  else
-    ppo_.set_action_bias(envs.spec().act_dim - 1, c.termination_bias);
+  ppo_.set_action_bias(envs.spec().act_dim - 1, c.termination_bias);
   torch::manual_seed(mix_seed(seed, 0x1ee));
   ProximitySpec ps;
   ps.obs_dim = obs_dim_;
