@@ -26,6 +26,7 @@ void WalkerCourse::reset_task() {
   set_obstacles(layout);
   WalkerEnv::reset_task();
   start_x_ = torso_x();
+  crossed_ = 0;
 }
 
 bool WalkerCourse::near_ceiling() const {
@@ -45,14 +46,30 @@ void WalkerCourse::features(double* out) const {
   if (const Obstacle* o = obstacle_behind()) out[o->kind == ObstacleKind::Curb ? 1 : 3] = x - o->end;
 }
 
+double WalkerCourse::mark_rewards() {
+  double r = 0.0;
+  const double foot = trailing_foot_x();
+  for (size_t k = 0; k < obstacles_.size(); ++k) {
+    if (obstacles_[k].kind != ObstacleKind::Curb) continue;
+    const auto marks = curb_marks(obstacles_[k]);
+    for (int j = 0; j < 3; ++j) {
+      const uint32_t bit = 1u << (3 * k + j);
+      if (!(crossed_ & bit) && foot > marks[j]) crossed_ |= bit, r += ccfg_.cross_bonus;
+      if (x_before_ <= marks[j] && marks[j] < torso_x())
+        r += ccfg_.mark_upward_weight * std::clamp(z_velocity(), -2.0, 2.0);
+    }
+  }
+  return r;
+}
+
 StepResult WalkerCourse::evaluate(const float* action) {
   StepResult r;
   bool ceiling = near_ceiling();
   double v = x_velocity();
-  r.reward = walk_reward(v, action, 1.0, ceiling ? 0.0 : 1.0);
+  r.reward = walk_reward(v, action, ccfg_.speed_weight, ceiling ? 0.0 : ccfg_.height_weight);
   bool contact = touching();
   if (contact) r.reward -= ocfg_.contact_penalty;
-  r.reward += ccfg_.pass_bonus * update_passed();
+  r.reward += ccfg_.pass_bonus * update_passed() + mark_rewards();
   bool fell = torso_z() < (ceiling ? ccfg_.ceiling_fall_height : cfg_.fall_height);
   bool all = passed_ == int(obstacles_.size());
   r.terminated = fell || contact || all;

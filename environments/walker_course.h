@@ -17,6 +17,14 @@ class WalkerCourse : public WalkerObstacleEnv {
     std::vector<std::string> kinds;      // "curb" or "ceiling" per obstacle
     bool shuffle = false;                // random order of `kinds` each episode
     double pass_bonus = 10.0;            // reward per obstacle passed
+    // The reference code's Hurdle reward, which its Single baseline trains on (about 600
+    // per curb with pass_bonus 200; ../shared/spec/walker-reference-code.md): the speed and
+    // height terms' weights (doubled there), + cross_bonus once each as the trailing foot
+    // (the spec's "lower foot", taken as the jump's) passes a curb's start, centre and end,
+    // + mark_upward_weight clip(vz, -2, 2) as the torso passes each of them (WalkerJump's
+    // terms of the same names). Defaults: ours.
+    double speed_weight = 1.0, height_weight = 1.0;
+    double cross_bonus = 0.0, mark_upward_weight = 0.0;
     double ceiling_zone = 3.0;           // within this of a ceiling, only a torso below
     double ceiling_fall_height = 0.3;    //   ceiling_fall_height is a fall (crawling is low)
   };
@@ -34,10 +42,19 @@ class WalkerCourse : public WalkerObstacleEnv {
 
  private:
   bool near_ceiling() const;
-  void save_extra(std::vector<double>& out) const override { out.push_back(start_x_); }
-  void restore_extra(const double* in, size_t n) override { start_x_ = n ? in[0] : 0.0; }
+  // cross_bonus and mark_upward_weight's terms earned this step.
+  double mark_rewards();
+  void save_extra(std::vector<double>& out) const override {
+    out.push_back(start_x_);
+    out.push_back(double(crossed_));
+  }
+  void restore_extra(const double* in, size_t n) override {
+    start_x_ = n ? in[0] : 0.0;
+    crossed_ = n > 1 ? uint32_t(in[1]) : 0u;
+  }
   Config ccfg_;
   double start_x_ = 0.0;
+  uint32_t crossed_ = 0;  // bit 3k + j: the trailing foot has passed mark j of obstacle k
   std::vector<ObstacleKind> kinds_;
 };
 

@@ -255,14 +255,14 @@ StepResult WalkerJump::evaluate(const float* action) {
   // Bonuses for the trailing foot crossing each curb's start, centre and end.
   const int marks = 3 * int(obstacles_.size());
   while (crossed_ < marks) {
-    if (trailing_foot_x() <= bonus_points(obstacles_[crossed_ / 3])[crossed_ % 3]) break;
+    if (trailing_foot_x() <= curb_marks(obstacles_[crossed_ / 3])[crossed_ % 3]) break;
     if (!(touched_ >> (crossed_ / 3) & 1u)) r.reward += jcfg_.cross_bonus;
     if (crossed_ % 3 == 0) r.reward += placement_reward(crossed_ / 3);
     ++crossed_;
   }
   if (jcfg_.mark_upward_weight != 0.0)
     for (const Obstacle& c : obstacles_)
-      for (double at : bonus_points(c))
+      for (double at : curb_marks(c))
         if (x_before_ <= at && at < torso_x())
           r.reward += jcfg_.mark_upward_weight * std::clamp(z_velocity(), -2.0, 2.0);
   double x = min_x();

@@ -58,6 +58,8 @@ class WalkerObstacleEnv : public WalkerEnv {
   const Obstacle* obstacle_ahead() const;
   const Obstacle* obstacle_behind() const;
   static constexpr double kFar = 1e6;  // a feature's value when no obstacle is there
+  // The three points of a curb crossing bonuses are paid at: its start, centre and end.
+  static std::array<double, 3> curb_marks(const Obstacle& c) { return {c.start, 0.5 * (c.start + c.end), c.end}; }
 
  protected:
   // Moves the model's obstacle geoms to this layout; unused ones are parked.
@@ -177,8 +179,6 @@ class WalkerJump : public WalkerObstacleEnv {
 
  private:
   static constexpr double kFootRadius = 0.06;  // walker_base.xml's foot capsules
-  // The three points of a curb the bonuses are paid at: its start, centre and end.
-  static std::array<double, 3> bonus_points(const Obstacle& c) { return {c.start, 0.5 * (c.start + c.end), c.end}; }
   // How far the bottom of `foot` (a body id) is above the ground, as a fraction of the
   // curb's height, in [0, 1].
   double clearance(int foot, double height) const;

@@ -3,6 +3,9 @@
 // meta-controller walks through the documented skill sequence.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "tests/task_fixture.h"
 #include "environments/walker_course.h"
 #include "hrl/meta_controller.h"
@@ -60,6 +63,74 @@ TEST(Hurdle, CountsEachCurbOnceAtOnePointFiveMetresPastItsEnd) {
     if (r.done()) break;
   }
   EXPECT_EQ(count, 5);
+}
+
+// The reference code's Hurdle reward (Single's, off by default): the pass and crossing
+// bonuses once per curb, the speed and height terms at their weights, the torso's
+// vertical speed as it passes a mark. Each is the difference of two twin envs' rewards.
+TEST(Hurdle, ReferenceRewardTermsByHand) {
+  const std::string base = "{position_noise: 0, push_prob: 0";
+  auto reference = make_task("hurdle", base + ", pass_bonus: 200, cross_bonus: 100}");
+  auto ours = make_task("hurdle", base + "}");
+  std::vector<float> obs(28);
+  reference->reset(0, obs.data());
+  ours->reset(0, obs.data());
+  // Teleported past curb 0 (8.0-8.2) + 1.5: its three marks and its pass in one step,
+  // (200 - 10) + 3 x 100; a step further on pays nothing more.
+  for (auto [x, extra] : {std::pair{9.75, 490.0}, std::pair{10.0, 0.0}})
+    EXPECT_NEAR(step_at(*reference, x, obs).reward - step_at(*ours, x, obs).reward, extra, 1e-9) << x;
+  // A snapshot carries the marks crossed: restored elsewhere, curb 0 pays nothing again.
+  std::vector<double> snapshot;
+  reference->save_state(snapshot);
+  auto restored = make_task("hurdle", base + ", pass_bonus: 200, cross_bonus: 100}");
+  restored->reset(1, obs.data());
+  restored->restore_state(snapshot, obs.data());
+  EXPECT_NEAR(step_at(*restored, 10.25, obs).reward - step_at(*ours, 10.25, obs).reward, 0.0, 1e-9);
+
+  // speed_weight w pays w (3 - |v - 3|), height_weight w charges w |1.1 - delta_h|.
+  auto weighted = [&](const std::string& weights, double& v, double& delta_h) {
+    auto env = make_task("hurdle", base + ", " + weights + "}");
+    env->reset(0, obs.data());
+    auto& course = dynamic_cast<WalkerCourse&>(*env);
+    auto& m = dynamic_cast<MujocoEnv&>(*env);
+    m.mutable_data()->qpos[0] = 3.0;
+    m.forward(obs.data());
+    m.mutable_data()->qvel[0] = 2.0;
+    const double x0 = course.torso_x();
+    const double r = env->step(kZero, obs.data()).reward;
+    v = (course.torso_x() - x0) / 0.008, delta_h = course.delta_h();
+    return r;
+  };
+  double v, delta_h;
+  const double speed = weighted("speed_weight: 2, height_weight: 0", v, delta_h) -
+                       weighted("speed_weight: 1, height_weight: 0", v, delta_h);
+  EXPECT_NEAR(speed, 3 - std::abs(v - 3), 1e-9);
+  EXPECT_GT(v, 1.0);
+  const double height = weighted("speed_weight: 0, height_weight: 2", v, delta_h) -
+                        weighted("speed_weight: 0, height_weight: 1", v, delta_h);
+  EXPECT_NEAR(height, -std::abs(1.1 - delta_h), 1e-9);
+
+  // The torso at 7.99, 0.5 m up, moving 3 m/s forward passes the curb's start in one
+  // control step: mark_upward_weight 100 pays 100 clip(vz, -2, 2), vz after the step.
+  for (double vz : {1.0, -3.0}) {
+    double reward[2], vz_after = 0;
+    for (int e = 0; e < 2; ++e) {
+      auto env = make_task("hurdle", base + (e == 0 ? ", mark_upward_weight: 100}" : "}"));
+      env->reset(0, obs.data());
+      auto& m = dynamic_cast<MujocoEnv&>(*env);
+      double* qpos = m.mutable_data()->qpos;
+      double* qvel = m.mutable_data()->qvel;
+      std::fill(qpos + 2, qpos + 9, 0.0);
+      qpos[0] = 7.99, qpos[1] = 1.75;
+      std::fill(qvel, qvel + 9, 0.0);
+      qvel[0] = 3.0, qvel[1] = vz;
+      m.forward(obs.data());
+      reward[e] = env->step(kZero, obs.data()).reward;
+      vz_after = m.mutable_data()->qvel[1];
+    }
+    EXPECT_NEAR(reward[0] - reward[1], 100 * std::clamp(vz_after, -2.0, 2.0), 1e-6) << vz;
+    EXPECT_NEAR(vz_after, vz - 9.81 * 0.008, 0.05);  // free flight for one step
+  }
 }
 
 // The reference code counts a ceiling 0.15 m past its end (ceiling_pass_margin), a curb
