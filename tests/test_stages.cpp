@@ -53,9 +53,10 @@ class Stages : public TempDirTest {
  protected:
   Stages() : TempDirTest("stages") {}
   // Two PPO iterations of 1024 steps per stage on a 50-step walk.
-  std::string recipe(const std::string& second, const std::string& run = "run") {
+  // `head`: top-level keys of the file (e.g. where its first stage starts from).
+  std::string recipe(const std::string& second, const std::string& run = "run", const std::string& head = "") {
     const std::string file = path(run + ".yaml");
-    std::ofstream(file) << "task: walker_forward\n"
+    std::ofstream(file) << head << "task: walker_forward\n"
                            "threads: 1\n"
                            "run_dir: " << path(run) << "\n"
                            "checkpoint_every: 1\n"
@@ -127,6 +128,21 @@ TEST_F(Stages, ContinuingFromThePolicyStartsFreshCounters) {
   EXPECT_EQ(rows[4][2], "2048");  // its own two iterations
   const std::string second = read_file(path("run/2-second/recipe.yaml"));
   EXPECT_NE(second.find("init_policy: " + path("run/1-first/policy.pt")), std::string::npos) << second;
+}
+
+TEST_F(Stages, ACurriculumFromAnExportedPolicyContinuesItsOwnCheckpointLater) {
+  // The file's init_policy is where the first stage starts; the second continues the
+  // first's checkpoint, and no longer also names that policy (which would be refused).
+  const std::string head = "init_policy: assets/policies/walker/walker_forward.pt\n";
+  ASSERT_EQ(run_segue("train " + recipe("", "run", head)), 0);
+  const std::string first = read_file(path("run/1-first/recipe.yaml"));
+  EXPECT_NE(first.find("init_policy: assets/policies/walker/walker_forward.pt"), std::string::npos) << first;
+  const std::string second = read_file(path("run/2-second/recipe.yaml"));
+  EXPECT_NE(second.find("init_from: " + path("run/1-first/checkpoint.pt")), std::string::npos) << second;
+  EXPECT_EQ(second.find("walker_forward.pt"), std::string::npos) << second;
+  auto rows = csv(path("run/metrics.csv"));
+  ASSERT_EQ(rows.size(), 5u);
+  EXPECT_EQ(rows[3][1], "3");  // the checkpoint's counters go on
 }
 
 }  // namespace segue

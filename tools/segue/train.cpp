@@ -279,7 +279,12 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
   auto stage_recipe = [&](size_t i, const std::string& start, int64_t total_steps) {
     YAML::Node ov = YAML::Clone(stages[i].overrides);
     ov["run_dir"] = stage_dir(top, i, stages[i]);
-    if (i > 0) ov[stages[i].from_policy ? "init_policy" : "init_from"] = start;
+    // A later stage starts from the stage before only: the file's own start (its first
+    // stage's init_policy or init_from) is not carried over.
+    if (i > 0) {
+      ov[stages[i].from_policy ? "init_policy" : "init_from"] = start;
+      ov[stages[i].from_policy ? "init_from" : "init_policy"] = "";
+    }
     if (total_steps > 0) ov["ppo"]["total_steps"] = total_steps;
     return recipe.with_overrides(ov, recipe.file() + " (stage " + stages[i].name + ")");
   };
