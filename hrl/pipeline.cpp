@@ -226,7 +226,7 @@ int train_transition(const CompositeRecipe& r, int t, const std::string& dir, co
 
 // Lee et al. 2019. "success" in its log: hand-overs after which pi_b succeeded.
 int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const PipelineOptions& o) {
-  const TransitionPolicyConfig& cfg = r.pipeline.transition;
+  const TransitionPolicyConfig cfg = r.pipeline.lee.transition(r.pipeline.transition);
   const Skill& b = r.skills[r.meta.transitions()[t].to];
   StartStates starts = starts_of(r, t, dir);
   const int subtask_steps = r.pipeline.switching.max_subtask_steps;
@@ -377,7 +377,7 @@ void plan_job(const CompositeRecipe& r, JobPlan& plan) {
   }
   for (int t = 0; t < n; ++t) plan.add(r.transition_name(t) + " q_ab", c.switch_attempt * p.switching.attempts);
   for (int t = 0; t < n && p.lee.enabled; ++t)
-    plan.add(r.transition_name(t) + " Lee", c.lee_step * double(p.transition.ppo.total_steps));
+    plan.add(r.transition_name(t) + " Lee", c.lee_step * double(p.lee.transition(p.transition).ppo.total_steps));
   const int runs = int(method_names().size() * r.eval_seeds.size());
   plan.add("evaluate", c.eval_episode * runs * r.eval_episodes, runs);
 }

@@ -88,6 +88,13 @@ LeeConfig LeeConfig::read(const Section& s) {
   c.decay = s.get("decay", c.decay, Range::open_closed(0, 1));
   c.max_rows = s.get("max_rows", c.max_rows, Range::positive());
   c.termination_bias = s.get("termination_bias", c.termination_bias, Range::any());
+  c.total_steps = s.get("total_steps", c.total_steps, Range::non_negative());
+  return c;
+}
+
+TransitionPolicyConfig LeeConfig::transition(const TransitionPolicyConfig& tp) const {
+  TransitionPolicyConfig c = tp;
+  if (total_steps > 0) c.ppo.total_steps = total_steps;
   return c;
 }
 

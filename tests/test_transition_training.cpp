@@ -808,4 +808,30 @@ TEST_F(TransitionTraining, StoppedPpoStagesResumeToTheUnbrokenRun) {
   }
 }
 
+// Lee's policy trains with pi_ab's settings, but for its own budget when lee.total_steps
+// is given: here 1024 steps (two iterations of 4 x 128) against pi_ab's 2048 (four).
+TEST_F(TransitionTraining, LeeTrainsForItsOwnBudgetWhenGiven) {
+  tiny();  // writes the recipe file
+  CompositeRecipe r = CompositeRecipe::load(path("tiny_patrol.yaml"),
+                                            {"lee.enabled=true", "lee.total_steps=1024", "run_dir=" + path("run")});
+  EXPECT_EQ(r.pipeline.lee.transition(r.pipeline.transition).ppo.total_steps, 1024);
+  EXPECT_EQ(r.pipeline.lee.transition(r.pipeline.transition).ppo.gamma, r.pipeline.transition.ppo.gamma);
+  const std::string t = path("run/forward-balance/");
+  fs::create_directories(t);
+  save(collect_start_states(r, 0, r.pipeline.collect.start_states, 1), t + "start_states.pt");
+  save(collect_demonstrations(r, 0, r.pipeline.collect.demonstrations, 2), t + "demonstrations.pt");
+  PipelineOptions o;
+  o.command = "test";
+  ASSERT_EQ(run_pipeline(r, o), 0);
+  auto steps = [](const std::string& file) {  // the last row's global_step (second column)
+    std::ifstream in(file);
+    std::string line, last;
+    int rows = 0;
+    for (; std::getline(in, line); ++rows) last = line;
+    return std::make_pair(rows - 1, std::stod(last.substr(last.find(',') + 1)));
+  };
+  EXPECT_EQ(steps(t + "transition.csv"), std::make_pair(4, 2048.0));
+  EXPECT_EQ(steps(t + "lee.csv"), std::make_pair(2, 1024.0));
+}
+
 }  // namespace segue
