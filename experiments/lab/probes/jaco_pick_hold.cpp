@@ -1,8 +1,10 @@
 // Probe: how a pick or catch policy holds its box, episode by episode: the lift step, the
 // held steps, the hand-box distance while held, the finger actions and angles, and for a
-// failure the box's start, end and closest approach (a box knocked away, or one that slips).
+// failure the box's start, end and closest approach (a box knocked away, or one that slips),
+// and the step of the box's fastest horizontal move before any pick with what touched it then.
 // usage: probe_jaco_pick_hold POLICY.pt TASK [episodes]   (the task's reference settings)
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include "algorithms/policy.h"
@@ -34,12 +36,29 @@ int main(int argc, char** argv) {
     double dsum = 0, dmax = 0, closest = 9, fa[3] = {0, 0, 0}, fq[3] = {0, 0, 0};
     const Vec3 start = j->object_pos();
     Vec3 at_closest = start;
+    double vmax = 0;
+    int t_vmax = 0;
+    std::string touch;  // the geoms touching the box at its fastest move before a pick
     do {
       p.act(obs.data(), 1, act.data());
       r = env->step(act.data(), obs.data());
       ++t;
       const double d = j->hand_object_distance();
       if (d < closest) closest = d, t_closest = t, at_closest = j->object_pos();
+      const Vec3 v = j->object_velocity();
+      if (lift < 0 && std::hypot(v[0], v[1]) > vmax) {
+        vmax = std::hypot(v[0], v[1]), t_vmax = t, touch.clear();
+        const mjModel* m = j->model();
+        const mjData* dd = j->data();
+        for (int c = 0; c < dd->ncon; ++c) {
+          const int g1 = dd->contact[c].geom1, g2 = dd->contact[c].geom2;
+          const char* n1 = mj_id2name(m, mjOBJ_GEOM, g1);
+          const char* n2 = mj_id2name(m, mjOBJ_GEOM, g2);
+          const std::string a = n1 ? n1 : "?", b = n2 ? n2 : "?";
+          if (a == "object") touch += " " + b;
+          else if (b == "object") touch += " " + a;
+        }
+      }
       if (d < in_hand && j->object_z() > in_air) {
         if (lift < 0) lift = t;
         ++held, dsum += d, dmax = std::max(dmax, d);
@@ -57,6 +76,7 @@ int main(int argc, char** argv) {
       std::printf("   box start (%.3f %.3f %.3f) end (%.3f %.3f %.3f) closest %.3f at t=%d box then (%.3f %.3f %.3f)\n",
                   start[0], start[1], start[2], b[0], b[1], b[2], closest, t_closest, at_closest[0], at_closest[1],
                   at_closest[2]);
+      std::printf("   fastest box move before a pick %.2f m/s at t=%d, touching:%s\n", vmax, t_vmax, touch.c_str());
     }
     successes += r.info.success;
   }
