@@ -18,6 +18,7 @@
 #include "hrl/transition_env.h"
 #include "hrl/transition_policy.h"
 #include "temp_dir.h"
+#include "tests/csv.h"
 #include "tests/tiny_patrol.h"
 
 namespace segue {
@@ -823,12 +824,9 @@ TEST_F(TransitionTraining, LeeTrainsForItsOwnBudgetWhenGiven) {
   PipelineOptions o;
   o.command = "test";
   ASSERT_EQ(run_pipeline(r, o), 0);
-  auto steps = [](const std::string& file) {  // the last row's global_step (second column)
-    std::ifstream in(file);
-    std::string line, last;
-    int rows = 0;
-    for (; std::getline(in, line); ++rows) last = line;
-    return std::make_pair(rows - 1, std::stod(last.substr(last.find(',') + 1)));
+  auto steps = [](const std::string& file) {  // iterations, and the last row's global_step
+    const auto rows = csv(file);
+    return std::make_pair(int(rows.size()) - 1, std::stod(rows.back()[1]));
   };
   EXPECT_EQ(steps(t + "transition.csv"), std::make_pair(4, 2048.0));
   EXPECT_EQ(steps(t + "lee.csv"), std::make_pair(2, 1024.0));

@@ -46,8 +46,9 @@ int main(int argc, char** argv) {
       const double d = j->hand_object_distance();
       if (d < closest) closest = d, t_closest = t, at_closest = j->object_pos();
       const Vec3 v = j->object_velocity();
-      if (lift < 0 && std::hypot(v[0], v[1]) > vmax) {
-        vmax = std::hypot(v[0], v[1]), t_vmax = t, touch.clear();
+      const double speed = std::hypot(v[0], v[1]);
+      if (lift < 0 && speed > vmax) {
+        vmax = speed, t_vmax = t, touch.clear();
         const mjModel* m = j->model();
         const mjData* dd = j->data();
         for (int c = 0; c < dd->ncon; ++c) {
