@@ -93,6 +93,10 @@ void JacoEnv::throw_object(double force, const Vec3& aim) {
   std::fill(f, f + 6, 0.0);
 }
 
+void JacoEnv::unwind_arm() {
+  for (int i = 0; i < kArmJoints; ++i) data_->qpos[i] = std::remainder(data_->qpos[i], 2 * M_PI);
+}
+
 void JacoEnv::move_geom(const char* name, const Vec3& pos) {
   int id = mj_name2id(model_, mjOBJ_GEOM, name);
   if (id < 0) throw Error(spec_.name + ": the model has no geom '" + name + "'");

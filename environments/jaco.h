@@ -31,7 +31,8 @@ Vec3 read_vec3(const Section& env, const std::string& key, const Vec3& fallback)
 
 class JacoEnv : public MujocoEnv {
  public:
-  static constexpr int kArmDof = 9;  // j1..j6, three fingers
+  static constexpr int kArmDof = 9;     // j1..j6, three fingers
+  static constexpr int kArmJoints = 6;  // j1..j6: hinges without limits
   // with_rotation: observe the object's quaternion and angular velocity (pick and catch:
   // 49 numbers); without (toss and hit: 39).
   JacoEnv(const std::string& name, const JacoConfig& config, const std::string& model_file,
@@ -56,6 +57,11 @@ class JacoEnv : public MujocoEnv {
   void move_geom(const char* name, const Vec3& pos);
   // Holds the object where it is, at rest (Repetitive catching pins the next box).
   void pin_object(const Vec3& pos);
+  // Turns each of j1..j6 by whole turns to the angle in [-pi, pi]: the same pose (these
+  // hinges have no limits, springs or position servos), with the raw angles of a fresh
+  // start. The arm's skills turn the wrist a turn or two per pick or catch, so without this
+  // every cycle of a repetitive task starts them from angles they never saw.
+  void unwind_arm();
 
   // Features (what transition intervals and expert windows are written in): steps (since
   // the episode start), object_z; a task appends its own.

@@ -51,6 +51,7 @@ StepResult JacoRepetitivePick::score(const float* action) {
       // The next box, on the tile again. (The reference returns the observation from before
       // this; ours shows the new box, which is what the next pick, or pi_ab, works from.)
       pick_.place(*this, rng_);
+      if (k_.unwind_arm) unwind_arm();
       mj_forward(model_, data_);
       pick_.begin(*this);
     }
@@ -113,6 +114,7 @@ StepResult JacoRepetitiveCatch::score(const float* action) {
       catch_.begin();
       if (n_.successes < k_.successes) {
         catch_.pin_at_start(*this);
+        if (k_.unwind_arm) unwind_arm();
         mj_kinematics(model_, data_);
         n_.wait = 1;
       }

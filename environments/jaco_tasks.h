@@ -8,7 +8,8 @@ namespace segue {
 
 // Repetitive picking up: pick the box and hold it 50 steps, `successes` times. After each
 // success the box is put back on its tile (fresh noise) and the pick starts over.
-// Ends on a drop, when one pick takes pick_steps steps, or at the last success.
+// Ends on a drop, when one pick takes pick_steps steps, or at the last success. With
+// unwind_arm the arm's unlimited joints are unwound at each success (docs/jaco.md).
 // Features: steps, object_z, successes, since_success (steps since the last success; far
 // before the first), pick_steps (steps into the current pick).
 class JacoRepetitivePick : public JacoEnv {
@@ -16,6 +17,7 @@ class JacoRepetitivePick : public JacoEnv {
   struct Config {
     int successes = 5;
     int pick_steps = 200;  // the pick's own time limit (its time bonus counts down from it)
+    bool unwind_arm = false;  // true: each success also unwinds the arm (JacoEnv::unwind_arm); the reference: no
     PickRule::Config pick;
   };
   JacoRepetitivePick(const std::string& name, const JacoConfig& c, const Config& k);
@@ -42,7 +44,8 @@ class JacoRepetitivePick : public JacoEnv {
 // steps, falls freely for fall_steps and is thrown. Ends on the first drop or at the last
 // success. The reference throws from rest (fall_steps 0, and no random steps before the
 // first throw), where its Catch sub-task throws after 10 random steps of free fall; our
-// default throws every box as the Catch sub-task does (see docs/jaco.md).
+// default throws every box as the Catch sub-task does (see docs/jaco.md). With unwind_arm
+// the arm's unlimited joints are unwound at each success, as in Repetitive picking.
 // Features: steps, object_z, successes, since_success (far before the first), since_throw
 // (steps since the last throw), waiting (1 from a success to the next throw).
 class JacoRepetitiveCatch : public JacoEnv {
@@ -51,6 +54,7 @@ class JacoRepetitiveCatch : public JacoEnv {
     int successes = 5;
     int pin_steps = 49;
     int fall_steps = 10;
+    bool unwind_arm = false;  // true: each success also unwinds the arm (JacoEnv::unwind_arm); the reference: no
     CatchRule::Config catching;
   };
   JacoRepetitiveCatch(const std::string& name, const JacoConfig& c, const Config& k);

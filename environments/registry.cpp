@@ -181,6 +181,7 @@ Factory repetitive_picking(const std::string& name, const Section& env) {
   JacoRepetitivePick::Config k;
   k.successes = read_successes(env);
   k.pick_steps = env.get("pick_steps", k.pick_steps, Range::at_least(1));
+  k.unwind_arm = env.get("unwind_arm", k.unwind_arm);
   k.pick = PickRule::Config::read(env);
   return [=] { return std::make_unique<JacoRepetitivePick>(name, c, k); };
 }
@@ -192,6 +193,7 @@ Factory repetitive_catching(const std::string& name, const Section& env) {
   k.successes = read_successes(env);
   k.pin_steps = env.get("pin_steps", k.pin_steps, Range::non_negative());
   k.fall_steps = env.get("fall_steps", k.fall_steps, Range::non_negative());
+  k.unwind_arm = env.get("unwind_arm", k.unwind_arm);
   k.catching = CatchRule::Config::read(env, /*hold_target=*/{0.0, 0.2, 0.2});  // KeepCatch's, not Catch's
   return [=] { return std::make_unique<JacoRepetitiveCatch>(name, c, k); };
 }

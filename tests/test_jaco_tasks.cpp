@@ -287,4 +287,44 @@ TEST(JacoComposites, SnapshotsReplayExactlyWithTheirBookkeeping) {
   }
 }
 
+TEST(JacoComposites, UnwindArmTurnsTheJointsByWholeTurnsAtEachSuccess) {
+  // The arm held at kHandLow with its wrist joints wound up (j4 one turn on, j6 two turns
+  // back), as a pick or catch leaves them. With unwind_arm a success turns them back to
+  // [-pi, pi] (here 0.5 and 0.2); the pose, and so the hand, is the same as without it.
+  const double kTurn = 2 * M_PI;
+  const std::vector<double> wound = {0, 0.3, 0, kTurn + 0.5, 0, -2 * kTurn + 0.2};
+  for (const std::string task : {"repetitive_picking", "repetitive_catching"}) {
+    std::vector<std::vector<double>> q(2);
+    std::vector<Vec3> hand(2);
+    for (int unwind : {0, 1}) {
+      auto env = make_arm<JacoEnv>(task, unwind ? "{unwind_arm: true}" : "{}");
+      object_contacts_off(*env);
+      std::vector<float> obs(49);
+      env->reset(4, obs.data());
+      StepResult r;
+      for (int t = 0; t < 50; ++t) {
+        hold_arm(*env, wound);
+        env->forward(obs.data());
+        pin(*env, env->hand_pos(), obs);
+        r = env->step(kZero.data(), obs.data());
+      }
+      ASSERT_EQ(r.info.success_count, 1) << task;
+      q[unwind].assign(env->data()->qpos, env->data()->qpos + 6);
+      hand[unwind] = env->hand_pos();
+      EXPECT_EQ(obs[3], float(q[unwind][3])) << task;  // the observation shows the angles as they are
+    }
+    EXPECT_NEAR(q[0][3], kTurn + 0.5, 0.05) << task;  // the reference's raw angles wind on
+    EXPECT_NEAR(q[0][5], -2 * kTurn + 0.2, 0.05) << task;
+    for (int i = 0; i < 6; ++i) {
+      EXPECT_GE(q[1][i], -M_PI) << task << " joint " << i;
+      EXPECT_LE(q[1][i], M_PI) << task << " joint " << i;
+      const double turns = (q[0][i] - q[1][i]) / kTurn;
+      EXPECT_NEAR(turns, std::round(turns), 1e-9) << task << " joint " << i;
+    }
+    EXPECT_NEAR(q[1][3], 0.5, 0.05) << task;
+    EXPECT_NEAR(q[1][5], 0.2, 0.05) << task;
+    EXPECT_NEAR(distance(hand[0], hand[1]), 0.0, 1e-9) << task;
+  }
+}
+
 }  // namespace segue
