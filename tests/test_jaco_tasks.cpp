@@ -19,9 +19,9 @@ namespace {
 const std::vector<double> kHandLow = {0, 0.3, 0, 0, 0, 0};  // shoulder turned down: the hand at z ~0.1
 const std::vector<float> kZero(9, 0.0f);
 
-// One step with the arm held at kHandLow and the box pinned in the hand.
-StepResult held_step(JacoEnv& env, std::vector<float>& obs) {
-  hold_arm(env, kHandLow);
+// One step with the arm held at q and the box pinned in the hand.
+StepResult held_step(JacoEnv& env, std::vector<float>& obs, const std::vector<double>& q = kHandLow) {
+  hold_arm(env, q);
   env.forward(obs.data());
   pin(env, env.hand_pos(), obs);
   return env.step(kZero.data(), obs.data());
@@ -302,20 +302,15 @@ TEST(JacoComposites, UnwindArmTurnsTheJointsByWholeTurnsAtEachSuccess) {
       std::vector<float> obs(49);
       env->reset(4, obs.data());
       StepResult r;
-      for (int t = 0; t < 50; ++t) {
-        hold_arm(*env, wound);
-        env->forward(obs.data());
-        pin(*env, env->hand_pos(), obs);
-        r = env->step(kZero.data(), obs.data());
-      }
+      for (int t = 0; t < 50; ++t) r = held_step(*env, obs, wound);
       ASSERT_EQ(r.info.success_count, 1) << task;
-      q[unwind].assign(env->data()->qpos, env->data()->qpos + 6);
+      q[unwind].assign(env->data()->qpos, env->data()->qpos + JacoEnv::kArmJoints);
       hand[unwind] = env->hand_pos();
       EXPECT_EQ(obs[3], float(q[unwind][3])) << task;  // the observation shows the angles as they are
     }
     EXPECT_NEAR(q[0][3], kTurn + 0.5, 0.05) << task;  // the reference's raw angles wind on
     EXPECT_NEAR(q[0][5], -2 * kTurn + 0.2, 0.05) << task;
-    for (int i = 0; i < 6; ++i) {
+    for (int i = 0; i < JacoEnv::kArmJoints; ++i) {
       EXPECT_GE(q[1][i], -M_PI) << task << " joint " << i;
       EXPECT_LE(q[1][i], M_PI) << task << " joint " << i;
       const double turns = (q[0][i] - q[1][i]) / kTurn;
