@@ -7,6 +7,7 @@ seed), and success when re-evaluated on other seeds.
   tools/skills_table.py --reeval 0,1    first evaluate every shipped skill (`segue eval`,
                                         50 episodes, the task's reference settings) on
                                         those seeds and record them in the manifests
+  ... --reeval 0,1 --skills jaco_pick   only those skills (e.g. one just shipped)
 """
 import argparse
 import json
@@ -19,6 +20,7 @@ GROUPS = {"walker": ["walker_forward", "walker_backward", "walker_balance", "wal
 
 ap = argparse.ArgumentParser()
 ap.add_argument("--reeval", default="")
+ap.add_argument("--skills", default="", help="comma-separated skills to re-evaluate (default: all)")
 args = ap.parse_args()
 
 print("| skill | recipe | env steps | wall time | success in the run | success on seeds |")
@@ -31,7 +33,8 @@ for group, tasks in GROUPS.items():
         if e is None:
             print(f"| {task} | not shipped yet | | | | |")
             continue
-        for seed in [s for s in args.reeval.split(",") if s]:
+        reeval = args.reeval if not args.skills or task in args.skills.split(",") else ""
+        for seed in [s for s in reeval.split(",") if s]:
             out = subprocess.run([os.path.join(ROOT, "build", "segue"), "eval", os.path.join(ROOT, e["file"]),
                                   "--task", task, "--episodes", "50", "--seed", seed, "--json"],
                                  check=True, capture_output=True, text=True).stdout
