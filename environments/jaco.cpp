@@ -22,8 +22,6 @@ JacoConfig JacoConfig::read(const Section& s, JacoConfig c) {
   c.ctrl_cost = s.get("ctrl_cost", c.ctrl_cost, Range::non_negative());
   c.qvel_cost = s.get("qvel_cost", c.qvel_cost, Range::non_negative());
   c.qacc_cost = s.get("qacc_cost", c.qacc_cost, Range::non_negative());
-  c.hard_start_share = s.get("hard_start_share", c.hard_start_share, Range::closed(0.0, 1.0));
-  c.hard_start_distance = s.get("hard_start_distance", c.hard_start_distance, Range::positive());
   return c;
 }
 
@@ -113,21 +111,14 @@ void JacoEnv::random_steps(int n) {
 }
 
 void JacoEnv::reset_task() {
-  const bool hard = cfg_.hard_start_share > 0 && rng_.uniform(0, 1) < cfg_.hard_start_share;
-  for (int attempt = 1;; ++attempt) {
-    for (int i = 0; i < kArmDof; ++i) {
-      data_->qpos[i] = model_->qpos0[i] + rng_.symmetric(cfg_.init_noise);
-      data_->qvel[i] = rng_.symmetric(cfg_.init_noise);
-    }
-    place_task_object();
-    mj_forward(model_, data_);
-    begin_task();
-    random_steps(cfg_.init_random_steps);
-    if (!hard || attempt == 100) break;
-    mj_kinematics(model_, data_);
-    if (hand_object_distance() < cfg_.hard_start_distance) break;
-    mj_resetData(model_, data_);
+  for (int i = 0; i < kArmDof; ++i) {
+    data_->qpos[i] = model_->qpos0[i] + rng_.symmetric(cfg_.init_noise);
+    data_->qvel[i] = rng_.symmetric(cfg_.init_noise);
   }
+  place_task_object();
+  mj_forward(model_, data_);
+  begin_task();
+  random_steps(cfg_.init_random_steps);
   after_random_steps();
 }
 

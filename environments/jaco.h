@@ -22,12 +22,6 @@ struct JacoConfig {
   double ctrl_cost = 1e-4;
   double qvel_cost = 1e-8;
   double qacc_cost = 1e-8;
-  // Not in the reference (share 0 there): this share of the resets is drawn again, up to 100
-  // times, until the random steps leave the hand within hard_start_distance of the object.
-  // The pick fails mostly from such starts (the hand near the box and moving fast), rare
-  // under the reference's reset; a training curriculum for them.
-  double hard_start_share = 0.0;
-  double hard_start_distance = 0.2;
 
   static JacoConfig read(const Section& env, JacoConfig defaults);
 };

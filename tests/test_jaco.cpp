@@ -247,26 +247,6 @@ TEST(Jaco, PickPushWeightCostsTheBoxsHorizontalMoveBeforeThePick) {
   EXPECT_NEAR(reward[1], reward[0] - 10 * moved, 1e-9);
 }
 
-TEST(Jaco, HardStartsDrawTheResetAgainUntilTheHandIsNearTheBox) {
-  // The reference reset (10 random steps) leaves the hand within 0.2 m of the box now and
-  // then; with hard_start_share 1 every reset does, and a distance no reset reaches still
-  // ends the reset (after 100 draws).
-  std::vector<float> obs(49);
-  auto plain = make_arm<JacoPick>("jaco_pick");
-  auto hard = make_arm<JacoPick>("jaco_pick", "{hard_start_share: 1, hard_start_distance: 0.2}");
-  auto never = make_arm<JacoPick>("jaco_pick", "{hard_start_share: 1, hard_start_distance: 0.001}");
-  int near = 0;
-  for (int seed = 0; seed < 30; ++seed) {
-    plain->reset(seed, obs.data());
-    near += plain->hand_object_distance() < 0.2;
-    hard->reset(seed, obs.data());
-    EXPECT_LT(hard->hand_object_distance(), 0.2) << "seed " << seed;
-  }
-  EXPECT_LT(near, 15);
-  never->reset(0, obs.data());
-  EXPECT_GT(never->hand_object_distance(), 0.001);
-}
-
 TEST(Jaco, PickFailsWhenTheBoxLeavesTheHandAfterThePick) {
   auto env = make_arm<JacoPick>("jaco_pick", "{init_random_steps: 0}");
   object_contacts_off(*env);
