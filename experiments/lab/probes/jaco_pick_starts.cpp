@@ -19,7 +19,7 @@ using namespace segue;
 namespace {
 // Plays one episode from the env's current state: a brake for `brake` steps, then the policy.
 // Returns success; `moved_at_10` gets the box's distance from `box0` after 10 steps.
-bool play(Env& env, JacoEnv& j, Policy& p, int brake, float* obs, float* act, const Vec3& box0, double& closest,
+bool play(JacoEnv& env, Policy& p, int brake, float* obs, float* act, const Vec3& box0, double& closest,
           double& moved_at_10) {
   StepResult r;
   int t = 0;
@@ -31,8 +31,8 @@ bool play(Env& env, JacoEnv& j, Policy& p, int brake, float* obs, float* act, co
       p.act(obs, 1, act);
     }
     r = env.step(act, obs);
-    closest = std::min(closest, j.hand_object_distance());
-    if (++t == 10) moved_at_10 = distance(box0, j.object_pos());
+    closest = std::min(closest, env.hand_object_distance());
+    if (++t == 10) moved_at_10 = distance(box0, env.object_pos());
   } while (!r.done());
   return r.info.success;
 }
@@ -62,10 +62,11 @@ int main(int argc, char** argv) {
     for (int k = 6; k < 9; ++k) fingers += obs[k];
     speed = std::sqrt(speed);
     const double wrist = std::fabs(obs[21]);
-    const double box_speed = std::sqrt(obs[25] * obs[25] + obs[26] * obs[26] + obs[27] * obs[27]);
+    const Vec3 v = j->object_velocity();
+    const double box_speed = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
     const Vec3 box0 = j->object_pos();
     double closest = d, moved = 0;
-    const int g = play(*env, *j, p, 0, obs.data(), act.data(), box0, closest, moved) ? 1 : 0;
+    const int g = play(*j, p, 0, obs.data(), act.data(), box0, closest, moved) ? 1 : 0;
     const Vec3 box1 = j->object_pos();
     double row[5] = {1, d, hz, speed, fingers};
     for (int k = 0; k < 5; ++k) sum[g][k] += row[k];
@@ -74,7 +75,7 @@ int main(int argc, char** argv) {
     for (int b = 0; b < 2; ++b) {
       double ignored = 0;
       env->restore_state(start, obs.data());
-      const bool won = play(*env, *j, p, b ? 10 : 5, obs.data(), act.data(), box0, ignored, moved);
+      const bool won = play(*j, p, b ? 10 : 5, obs.data(), act.data(), box0, ignored, moved);
       braked_wins[b] += won;
       saved = saved || won;
     }
