@@ -20,8 +20,10 @@ template <> const char* type_name<std::vector<std::string>>() { return "a list o
 
 namespace {
 
+// A list index has at most four digits: a longer number is read as a key, since stoul
+// would overflow on it and --set would pad a list up to it (both found by the fuzzer).
 bool is_index(const std::string& part) {
-  return !part.empty() && std::all_of(part.begin(), part.end(), [](char c) { return c >= '0' && c <= '9'; });
+  return !part.empty() && part.size() <= 4 && std::all_of(part.begin(), part.end(), [](char c) { return c >= '0' && c <= '9'; });
 }
 
 std::vector<std::string> split_key(const std::string& key) {
@@ -58,6 +60,8 @@ void set_path(YAML::Node root, const std::vector<std::string>& parts, const YAML
     if (parent.IsSequence() && is_index(parts[i])) {
       size_t k = std::stoul(parts[i]);
       while (parent.size() <= k) parent.push_back(fresh());
+      // An item that is not a section becomes one, as a key's value does below (found by the fuzzer).
+      if (!(parent[k].IsMap() || parent[k].IsSequence())) parent[k] = fresh();
       chain.push_back(parent[k]);
       continue;
     }
@@ -80,22 +84,42 @@ void set_path(YAML::Node root, const std::vector<std::string>& parts, const YAML
 
 // yaml-cpp keeps both entries of a key written twice, and lookups find the first: a
 // recipe that sets a key twice is refused instead. So is a key that is not a plain name
-// (YAML allows `? [1, 2]: x`; found by the fuzzer).
-void refuse_bad_keys(const YAML::Node& node, const std::string& prefix, const std::string& file) {
-  if (node.IsMap()) {
-    std::set<std::string> seen;
-    for (const auto& kv : node) {
-      if (!kv.first.IsScalar())
-        throw Error(file + ": a key " + (prefix.empty() ? "at the top" : "under '" + prefix + "'") +
-                    " is not a plain name");
-      const std::string key = kv.first.Scalar(), path = prefix.empty() ? key : prefix + "." + key;
-      if (!seen.insert(key).second) throw Error(file + ": key '" + path + "' is given twice");
-      refuse_bad_keys(kv.second, path, file);
+// (YAML allows `? [1, 2]: x`), a node that holds itself through an alias (`a: &x {b: *x}`,
+// which every reader would follow forever) and aliases that multiply a small file into a
+// huge tree (each alias of an alias doubles it): all three found by the fuzzer.
+struct KeyWalk {
+  const std::string& file;
+  std::vector<YAML::Node> ancestors;  // the path from the root, to tell a cycle
+  size_t visited = 0;
+
+  void walk(const YAML::Node& node, const std::string& prefix) {
+    constexpr size_t kMaxNodes = 100000;  // the largest recipe shipped holds a few hundred
+    if (++visited > kMaxNodes)
+      throw Error(file + ": more than " + std::to_string(kMaxNodes) + " values once its aliases are expanded");
+    if (!node.IsMap() && !node.IsSequence()) return;
+    for (const YAML::Node& above : ancestors)
+      if (node.is(above))
+        throw Error(file + ": key '" + (prefix.empty() ? std::string("(top)") : prefix) +
+                    "' holds itself through a YAML alias");
+    ancestors.push_back(node);
+    if (node.IsMap()) {
+      std::set<std::string> seen;
+      for (const auto& kv : node) {
+        if (!kv.first.IsScalar())
+          throw Error(file + ": a key " + (prefix.empty() ? "at the top" : "under '" + prefix + "'") +
+                      " is not a plain name");
+        const std::string key = kv.first.Scalar(), path = prefix.empty() ? key : prefix + "." + key;
+        if (!seen.insert(key).second) throw Error(file + ": key '" + path + "' is given twice");
+        walk(kv.second, path);
+      }
+    } else {
+      for (size_t i = 0; i < node.size(); ++i) walk(node[i], prefix + "." + std::to_string(i));
     }
-  } else if (node.IsSequence()) {
-    for (size_t i = 0; i < node.size(); ++i) refuse_bad_keys(node[i], prefix + "." + std::to_string(i), file);
+    ancestors.pop_back();
   }
-}
+};
+
+void refuse_bad_keys(const YAML::Node& node, const std::string& file) { KeyWalk{file}.walk(node, ""); }
 
 void collect_leaves(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& out) {
   if (node.IsMap() && node.size() > 0) {
@@ -255,7 +279,7 @@ Recipe Recipe::parse(const std::string& text, const std::string& name,
     set_path(s->tree, split_key(key), value);
     s->overridden.insert(key);
   }
-  refuse_bad_keys(s->tree, "", name);  // the overrides' values included
+  refuse_bad_keys(s->tree, name);  // the overrides' values included
   return Recipe(s);
 }
 

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <tuple>
 
 #include "core/mujoco_env.h"
 #include "core/recipe.h"
@@ -124,6 +125,47 @@ TEST(Recipe, WrongTypeAndMalformedYaml) {
       EXPECT_STREQ(e.what(), "k.yaml: a key under 'ppo' is not a plain name");
     }
   }
+  // A node that holds itself through an alias is refused, naming where the loop closes
+  // (every reader followed it until the stack ran out; found by the fuzzer in CI).
+  for (const auto& [text, set, where] : std::vector<std::tuple<std::string, std::string, std::string>>{
+           {"env: &x {push: *x}\n", "", "env.push"},
+           {"stages: &s [{ppo: {lr: 1}}, *s]\n", "", "stages.1"},
+           {"{}", "ppo=&x {a: [*x]}", "ppo.a.0"}}) {
+    try {
+      Recipe::parse(text, "c.yaml", set.empty() ? std::vector<std::string>{} : std::vector<std::string>{set});
+      ADD_FAILURE() << text << set;
+    } catch (const Error& e) {
+      EXPECT_EQ(std::string(e.what()), "c.yaml: key '" + where + "' holds itself through a YAML alias");
+    }
+  }
+  // Aliases of aliases multiply a few lines into 10^6 values: refused, not walked for minutes.
+  std::string bomb = "l0: &l0 [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n";
+  for (int i = 1; i <= 6; ++i) {
+    const std::string a = "*l" + std::to_string(i - 1);
+    bomb += "l" + std::to_string(i) + ": &l" + std::to_string(i) + " [" + a;
+    for (int j = 1; j < 10; ++j) bomb += ", " + a;
+    bomb += "]\n";
+  }
+  try {
+    Recipe::parse(bomb, "b.yaml");
+    ADD_FAILURE();
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "b.yaml: more than 100000 values once its aliases are expanded");
+  }
+  // --set into a list item that is not a section makes it one, as for a key's value
+  // (it threw yaml-cpp's own exception; found by the fuzzer).
+  Recipe item = Recipe::parse("stages: [plain]\n", "i.yaml", {"stages.0.ppo.lr=2e-4"});
+  EXPECT_EQ(item.root().items("stages").at(0).sub("ppo").get("lr", 1.0), 2e-4);
+  // A number too long for a list index is a key, never a list padded to it or an overflow.
+  for (const std::string set : {"stages.99999999999999999999.ppo.lr=1", "stages.100000000.ppo.lr=1"}) {
+    Recipe r = Recipe::parse("stages: [{ppo: {lr: 2}}]\n", "n.yaml", {set});
+    EXPECT_FALSE(r.root().is_sequence("stages")) << set;  // now a section keyed 0 and the number
+    EXPECT_EQ(r.root().sub("stages").sub(set.substr(7, set.find(".ppo") - 7)).sub("ppo").get("lr", 0.0), 1.0);
+  }
+  // A plain alias (the same settings used twice) still reads at both places.
+  Recipe shared = Recipe::parse("a: &x {lr: 0.5}\nb: *x\n", "s.yaml");
+  EXPECT_EQ(shared.root().sub("b").get("lr", 1.0), 0.5);
+  EXPECT_EQ(shared.root().sub("a").get("lr", 1.0), 0.5);
   EXPECT_THROW(Recipe::parse("{}", "r", {"no_equals_sign"}), Error);
 }
 

@@ -12,8 +12,17 @@ cmake -S tests/fuzz -B build-fuzz -G Ninja -DCMAKE_CXX_COMPILER=clang++ >/dev/nu
 cmake --build build-fuzz
 corpus=$(mktemp -d)
 cp tests/fuzz/corpus/* "$corpus"/
-build-fuzz/fuzz_recipe -max_total_time="${SEGUE_FUZZ_SECONDS:-60}" -timeout=10 -rss_limit_mb=2048 \
-  -print_final_stats=1 -artifact_prefix=build-fuzz/ "$corpus" 2>&1 | tail -3
+# On a finding, the report and the input (build-fuzz/crash-*, leak-*, ...) are printed.
+if build-fuzz/fuzz_recipe -max_total_time="${SEGUE_FUZZ_SECONDS:-60}" -timeout=10 -rss_limit_mb=2048 \
+  -print_final_stats=1 -artifact_prefix=build-fuzz/ "$corpus" >build-fuzz/fuzz.log 2>&1; then
+  tail -3 build-fuzz/fuzz.log
+else
+  status=$?
+  grep -v -E '^#[0-9]+ |^\s+NEW_FUNC' build-fuzz/fuzz.log | tail -60
+  echo "the recipe fuzzer failed (exit $status); its input, base64:"
+  base64 build-fuzz/{crash,leak,timeout,oom,slow-unit}-* 2>/dev/null || true
+  exit "$status"
+fi
 rm -rf "$corpus"
 # The suite under AddressSanitizer and UndefinedBehaviorSanitizer (build-asan/), less the
 # tests that measure learning or time kills (slow there, and no other code paths):
