@@ -2,7 +2,9 @@
 """Ships the transition artefacts of a finished `segue run`: copies RUN_DIR/NAME/{policy,q,lee}.pt
 to assets/policies/<group>/<task>/NAME/ and records what each cost in manifest.json there
 (environment steps and wall time, read from the stage CSVs; q_ab's switch margin from
-margins.csv), and copies RUN_DIR/TASK.md/json to experiments/results/.
+margins.csv), and copies RUN_DIR/TASK.md/json to experiments/results/. A stage the run did
+not train (its artefact copied in from the shipped set, byte for byte) keeps the shipped
+manifest's entry.
 
 usage: tools/ship_transitions.py RUN_DIR [--group walker] [--no-results]
 """
@@ -27,7 +29,16 @@ def last_row(path):
 recipe = open(os.path.join(args.run_dir, "recipe.yaml")).read()
 task = next(l.split(":", 1)[1].strip() for l in recipe.splitlines() if l.startswith("task:"))
 out_dir = os.path.join(root, "assets", "policies", args.group, task)
+manifest_path = os.path.join(out_dir, "manifest.json")
+shipped = json.load(open(manifest_path)).get("transitions", {}) if os.path.exists(manifest_path) else {}
 manifest = {"task": task, "recipe": f"experiments/{task}.yaml", "transitions": {}}
+stage_files = {"transition": "policy.pt", "switch": "q.pt", "lee": "lee.pt"}
+
+
+def same_file(a, b):
+    return os.path.exists(a) and os.path.exists(b) and open(a, "rb").read() == open(b, "rb").read()
+
+
 names = sorted(d for d in os.listdir(args.run_dir) if os.path.isfile(os.path.join(args.run_dir, d, "policy.pt")))
 if not names:
     sys.exit(f"{args.run_dir}: no transition has a policy.pt; is the run finished?")
@@ -35,14 +46,17 @@ for name in names:
     src, dst = os.path.join(args.run_dir, name), os.path.join(out_dir, name)
     os.makedirs(dst, exist_ok=True)
     entry = {}
-    for f in ("policy.pt", "q.pt", "lee.pt"):
+    for stage, f in stage_files.items():  # reused artefacts: compared before they are copied over
+        if not os.path.exists(os.path.join(src, stage + ".csv")) and same_file(os.path.join(src, f), os.path.join(dst, f)) and stage in shipped.get(name, {}):
+            entry[stage] = shipped[name][stage]
+    for f in stage_files.values():
         if os.path.exists(os.path.join(src, f)):
             shutil.copyfile(os.path.join(src, f), os.path.join(dst, f))
     for stage, csv_name, steps_key in (("transition", "transition.csv", "global_step"),
                                        ("switch", "switch.csv", "env_steps"),
                                        ("lee", "lee.csv", "global_step")):
         row = last_row(os.path.join(src, csv_name))
-        if row:
+        if row and stage not in entry:
             entry[stage] = {"env_steps": int(float(row[steps_key])) if steps_key in row and row[steps_key] else None,
                             "wall_seconds": round(float(row["wall_seconds"]), 1) if row.get("wall_seconds") else None}
             if stage == "transition":
@@ -59,7 +73,7 @@ for name in names:
         if rows[0].get("env_steps"):  # the stage's steps, the held-out check's included
             entry["switch"]["env_steps"] = int(float(rows[0]["env_steps"]))
     manifest["transitions"][name] = entry
-with open(os.path.join(out_dir, "manifest.json"), "w") as f:
+with open(manifest_path, "w") as f:
     json.dump(manifest, f, indent=2, sort_keys=True)
     f.write("\n")
 print(f"shipped {len(names)} transitions to {os.path.relpath(out_dir, root)}")
