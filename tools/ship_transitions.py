@@ -32,7 +32,8 @@ out_dir = os.path.join(root, "assets", "policies", args.group, task)
 manifest_path = os.path.join(out_dir, "manifest.json")
 shipped = json.load(open(manifest_path)).get("transitions", {}) if os.path.exists(manifest_path) else {}
 manifest = {"task": task, "recipe": f"experiments/{task}.yaml", "transitions": {}}
-stage_files = {"transition": "policy.pt", "switch": "q.pt", "lee": "lee.pt"}
+# stage, its artefact, its CSV's step column (the CSV is RUN_DIR/NAME/STAGE.csv)
+STAGES = (("transition", "policy.pt", "global_step"), ("switch", "q.pt", "env_steps"), ("lee", "lee.pt", "global_step"))
 
 
 def same_file(a, b):
@@ -46,17 +47,14 @@ for name in names:
     src, dst = os.path.join(args.run_dir, name), os.path.join(out_dir, name)
     os.makedirs(dst, exist_ok=True)
     entry = {}
-    for stage, f in stage_files.items():  # reused artefacts: compared before they are copied over
-        if not os.path.exists(os.path.join(src, stage + ".csv")) and same_file(os.path.join(src, f), os.path.join(dst, f)) and stage in shipped.get(name, {}):
-            entry[stage] = shipped[name][stage]
-    for f in stage_files.values():
+    for stage, f, steps_key in STAGES:
+        reused = same_file(os.path.join(src, f), os.path.join(dst, f))  # compared before it is copied over
         if os.path.exists(os.path.join(src, f)):
             shutil.copyfile(os.path.join(src, f), os.path.join(dst, f))
-    for stage, csv_name, steps_key in (("transition", "transition.csv", "global_step"),
-                                       ("switch", "switch.csv", "env_steps"),
-                                       ("lee", "lee.csv", "global_step")):
-        row = last_row(os.path.join(src, csv_name))
-        if row and stage not in entry:
+        row = last_row(os.path.join(src, stage + ".csv"))
+        if not row and reused and stage in shipped.get(name, {}):
+            entry[stage] = shipped[name][stage]
+        elif row:
             entry[stage] = {"env_steps": int(float(row[steps_key])) if steps_key in row and row[steps_key] else None,
                             "wall_seconds": round(float(row["wall_seconds"]), 1) if row.get("wall_seconds") else None}
             if stage == "transition":
