@@ -8,7 +8,7 @@ manifest's entry.
 
 usage: tools/ship_transitions.py RUN_DIR [--group walker] [--no-results]
 """
-import argparse, csv, json, os, shutil, sys
+import argparse, csv, filecmp, json, os, shutil, sys
 
 root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ap = argparse.ArgumentParser()
@@ -36,10 +36,6 @@ manifest = {"task": task, "recipe": f"experiments/{task}.yaml", "transitions": {
 STAGES = (("transition", "policy.pt", "global_step"), ("switch", "q.pt", "env_steps"), ("lee", "lee.pt", "global_step"))
 
 
-def same_file(a, b):
-    return os.path.exists(a) and os.path.exists(b) and open(a, "rb").read() == open(b, "rb").read()
-
-
 names = sorted(d for d in os.listdir(args.run_dir) if os.path.isfile(os.path.join(args.run_dir, d, "policy.pt")))
 if not names:
     sys.exit(f"{args.run_dir}: no transition has a policy.pt; is the run finished?")
@@ -48,8 +44,10 @@ for name in names:
     os.makedirs(dst, exist_ok=True)
     entry = {}
     for stage, f, steps_key in STAGES:
-        reused = same_file(os.path.join(src, f), os.path.join(dst, f))  # compared before it is copied over
-        if os.path.exists(os.path.join(src, f)):
+        have = os.path.exists(os.path.join(src, f))
+        reused = have and os.path.exists(os.path.join(dst, f)) and \
+            filecmp.cmp(os.path.join(src, f), os.path.join(dst, f), shallow=False)  # before it is copied over
+        if have:
             shutil.copyfile(os.path.join(src, f), os.path.join(dst, f))
         row = last_row(os.path.join(src, stage + ".csv"))
         if not row and reused and stage in shipped.get(name, {}):
