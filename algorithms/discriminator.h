@@ -16,7 +16,7 @@ namespace segue {
 
 struct DiscriminatorSpec {
   int obs_dim = 0, act_dim = 0;
-  std::vector<int> hidden{100, 100};  // g and h: 2 x 100 ReLU each (spec)
+  std::vector<int> hidden{100, 100};  // g and h: 2 x 100 ReLU each, the reference's (docs/reference/learners.md)
   double gamma = 0.99;
   // Periodic features of s appended to g's and h's state input, so D can tell states by
   // their phase, e.g. where a gait meets a curb (what pi_b's own features let it see).

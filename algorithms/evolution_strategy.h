@@ -12,7 +12,7 @@
 //
 // Why a second learner: PPO explores with noise drawn afresh each step, which averages
 // out over a stance, so it never tries a hop that is longer or shorter as a whole (the
-// jump's failure: experiments/results/NOTES.md, Jump). A perturbed parameter vector changes the policy for a
+// jump's failure: docs/history.md, the jump). A perturbed parameter vector changes the policy for a
 // whole episode, so the comparison within a pair is between two gaits.
 #include <cstdint>
 #include <string>

@@ -5,7 +5,8 @@
 #include <algorithm>
 #include <sstream>
 
-#include "algorithms/ppo.h"
+#include "algorithms/on_policy.h"
+#include "algorithms/sac.h"
 #include "core/error.h"
 #include "core/run_dir.h"
 
@@ -39,8 +40,11 @@ void Policy::act(const float* obs, int batch, float* actions) const {
   normalize(obs, batch, normalized_.data());
   mlp_.forward(normalized_.data(), batch, actions);
   for (int b = 0; b < batch; ++b)
-    for (int j = 0; j < k; ++j)
-      actions[size_t(b) * k + j] = std::clamp(actions[size_t(b) * k + j], act_low_[j], act_high_[j]);
+    for (int j = 0; j < k; ++j) {
+      float& a = actions[size_t(b) * k + j];
+      a = tanh_output_ ? act_low_[j] + 0.5f * (std::tanh(a) + 1.0f) * (act_high_[j] - act_low_[j])
+                       : std::clamp(a, act_low_[j], act_high_[j]);
+    }
 }
 
 Policy Policy::with_parameters(const std::vector<float>& theta) const {
@@ -79,6 +83,7 @@ void Policy::export_torchscript(const std::string& path) const {
   m.register_attribute("n_act", c10::IntType::get(), int64_t(act_dim()));
   m.register_attribute("activation", c10::StringType::get(), activation_name(mlp_.activation()));
   if (!source_.empty()) m.register_attribute("source", c10::StringType::get(), source_);
+  if (tanh_output_) m.register_attribute("tanh_output", c10::BoolType::get(), true);
   const size_t layers = mlp_.weights().size();
   std::ostringstream src;
   src << "def obs_dim(self) -> int:\n    return self.n_obs\n"
@@ -101,7 +106,10 @@ void Policy::export_torchscript(const std::string& path) const {
     src << "    x = torch.matmul(x, self.w" << i << ".t()) + self.b" << i << "\n";
     if (i + 1 < layers) src << "    x = torch." << activation_name(mlp_.activation()) << "(x)\n";
   }
-  src << "    return torch.max(torch.min(x, self.act_high), self.act_low)\n";
+  if (tanh_output_)
+    src << "    return self.act_low + 0.5 * (torch.tanh(x) + 1.0) * (self.act_high - self.act_low)\n";
+  else
+    src << "    return torch.max(torch.min(x, self.act_high), self.act_low)\n";
   m.define(src.str());
   std::ostringstream bytes;
   m.save(bytes);
@@ -126,6 +134,7 @@ Policy Policy::load_torchscript(const std::string& path) {
            float(m.attr("obs_clip").toDouble()), to_floats(m.attr("act_low").toTensor()),
            to_floats(m.attr("act_high").toTensor()), features);
   if (m.hasattr("source")) p.set_source(m.attr("source").toStringRef());
+  if (m.hasattr("tanh_output")) p.set_tanh_output(m.attr("tanh_output").toBool());
   // The Eigen forward must be the function the file defines: check on a random batch.
   torch::manual_seed(0);
   auto obs = torch::randn({8, p.obs_dim()}) * 3.0;
@@ -139,6 +148,19 @@ Policy Policy::load_torchscript(const std::string& path) {
   return p;
 }
 
+namespace {
+
+// A training checkpoint's deterministic policy, whichever learner wrote it.
+Policy checkpoint_policy(const std::string& path) {
+  torch::serialize::InputArchive ar;
+  ar.load_from(path);
+  torch::Tensor learner;
+  if (ar.try_read("meta_learner", learner) && to_text(learner) == "sac") return SAC::policy_from_checkpoint(path);
+  return OnPolicyLearner::policy_from_checkpoint(path);
+}
+
+}  // namespace
+
 Policy Policy::load(const std::string& path) {
   std::ifstream probe(path);
   if (!probe) throw Error(path + ": no such policy file");
@@ -150,7 +172,7 @@ Policy Policy::load(const std::string& path) {
   }
   try {
     if (m.find_method("act_dim")) return load_torchscript(path);
-    return PPO::policy_from_checkpoint(path);
+    return checkpoint_policy(path);
   } catch (const c10::Error& e) {
     std::string what = e.what_without_backtrace();
     throw Error(path + ": unreadable policy: " + what.substr(0, what.find('\n')));

@@ -1,6 +1,7 @@
 #pragma once
 // A trained policy as a plain function of the observation, for evaluation and for
 // composing skills: a = clamp(mu([clip((s - mean) * inv_std), features(s)]), low, high)
+// (or squashed by tanh into [low, high]: tanh_output())
 // (features: ObsFeatures, usually none). The same
 // function is exported as TorchScript (runnable with torch.jit.load in Python) and read
 // back from it; inference runs the Eigen mirror of the network.
@@ -35,6 +36,11 @@ class Policy {
   // obs: [batch, obs_dim] -> actions: [batch, act_dim]. Allocates only when the batch grows.
   void act(const float* obs, int batch, float* actions) const;
 
+  // Squash the network's output into the bounds, low + (tanh(x) + 1) (high - low) / 2
+  // (SAC's actor), instead of clamping it (PPO's and TRPO's).
+  bool tanh_output() const { return tanh_output_; }
+  void set_tanh_output(bool on) { tanh_output_ = on; }
+
   // What the policy is for, e.g. "hurdle walk-jump q.pt" (empty: not said). Kept in the
   // exported file so that a file copied into the wrong place can be refused.
   const std::string& source() const { return source_; }
@@ -56,6 +62,7 @@ class Policy {
   float obs_clip_ = 10.0f;
   ObsFeatures features_;
   std::string source_;
+  bool tanh_output_ = false;
   mutable std::vector<float> normalized_;
 };
 

@@ -1,168 +1,49 @@
 #pragma once
 // Proximal Policy Optimization with a clipped surrogate (Schulman et al. 2017), in the
-// spirit of CleanRL's single-file PPO: iterate() is one rollout followed by one update,
-// and every piece of state it touches is a member you can see here.
+// spirit of CleanRL's single-file PPO: iterate() (algorithms/on_policy.h) is one rollout
+// followed by update(), epochs of minibatch steps on the clipped objective.
 #include <torch/torch.h>
 
-#include <functional>
-#include <memory>
-#include <string>
-
-#include "algorithms/actor_critic.h"
-#include "algorithms/policy.h"
-#include "core/recipe.h"
-#include "core/rng.h"
-#include "core/rollout_buffer.h"
-#include "core/distributed.h"
-#include "core/running_mean_std.h"
-#include "core/vector_env.h"
+#include "algorithms/on_policy.h"
 
 namespace segue {
 
-// Limits checked when a recipe is read, before anything is allocated.
-constexpr int kMaxEnvs = 4096, kMaxStepsPerEnv = 100000;
-
-struct PpoConfig {
-  int64_t total_steps = 2'000'000;  // environment (control) steps over the whole run
-  int num_envs = 16;
-  int steps_per_env = 512;          // rollout = num_envs * steps_per_env
+struct PpoConfig : OnPolicyConfig {
   int epochs = 10;
   int minibatch_size = 2048;
   double lr = 3e-4;
   bool anneal_lr = true;
-  double gamma = 0.99;
-  double lambda = 0.95;
   double clip = 0.2;
   double vf_coef = 0.5;
   double ent_coef = 0.0;
-  // A floor under the policy's log std, kept after every update: PPO here has no working
-  // entropy bonus at these scales (ent_coef 0.01 blew the std up on the jump, 0.003 did
-  // not stop it falling to 0.04), so a continued run may need exploration held open.
-  double min_log_std = -20.0;       // -20: no floor
-  // Exploration noise held for this many steps before it is redrawn (as gSDE redraws its
-  // noise every n steps; Raffin et al. 2022). Independent noise each step averages out
-  // over a stance, so a gait's step length is never explored; noise held over a push-off
-  // changes it. Each action's marginal is still N(mu, sigma), which PPO's ratio uses.
-  int noise_repeat = 1;
   // Weight of action_bound_loss (ppo_loss.h) in the update; 0 leaves the mean unbounded.
   double bound_coef = 0.0;
   double max_grad_norm = 0.5;
-  bool normalize_reward = true;     // scale rewards by the std of the discounted return
-  double obs_clip = 10.0;
 
   static PpoConfig read(const Section& s, PpoConfig defaults);
   static PpoConfig read(const Section& s) { return read(s, PpoConfig()); }
-  int64_t rollout_size() const { return int64_t(num_envs) * steps_per_env; }
 };
 
-struct IterationStats {
-  int64_t iteration = 0, global_step = 0;
-  int episodes = 0;                 // episodes finished during the rollout
-  double episode_return = NAN, episode_length = NAN, success_rate = NAN, success_count = NAN;
-  double policy_loss = 0, value_loss = 0, entropy = 0, approx_kl = 0, clip_fraction = 0;
-  double rollout_seconds = 0, update_seconds = 0;
-  double comm_seconds = 0;          // of those, inside collectives with the other ranks
-};
-
-class PPO {
+class PPO : public OnPolicyLearner {
  public:
-  // With `group` of several ranks, PPO is data-parallel: each rank steps its share of the
-  // environments (envs.first_index() says which), and every update is the one a single
-  // process with all of them makes, to float tolerance: the same minibatch rows (one
+  // Data-parallel with `group` as OnPolicyLearner says: the same minibatch rows (one
   // permutation of the whole rollout), advantages normalised over the whole minibatch,
-  // gradients summed over ranks before the optimiser step, normalisers merged exactly.
+  // gradients summed over ranks before the optimiser step.
   PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed,
       const Distributed& group = Distributed::alone());
 
-  // One rollout of rollout_size() steps, then epochs of minibatch updates.
-  // Throws segue::Error if the loss or the rewards stop being finite.
-  IterationStats iterate();
-  void collect_rollout(IterationStats& stats);
-  void update(IterationStats& stats);
-
-  // Replaces the environment's rewards after a rollout is collected and before they are
-  // scaled and turned into advantages: a transition policy's reward comes from its AIRL
-  // discriminator (Eq. 3), not from the task. The hook sees raw observations, actions,
-  // log pi_old and dones, and writes buf.rewards.
-  using RewardHook = std::function<void(RolloutBuffer& buf)>;
-  void set_reward_hook(RewardHook hook) { reward_hook_ = std::move(hook); }
-  const RolloutBuffer& buffer() const { return buf_; }
-
-  // The deterministic policy (mean action, normaliser included).
-  Policy policy() const;
-  int64_t iteration() const { return iteration_; }
-  int64_t global_step() const { return global_step_; }
-  double wall_seconds() const { return wall_seconds_; }  // training time, across resumes
-  int64_t total_iterations() const;
-  ActorCritic& net() { return net_; }
-  const Distributed& group() const { return group_; }
-
-  // log pi(a|s) of the current policy at raw (unnormalised) observations, no gradient:
-  // AIRL's D needs the generator's density at the expert's actions (Eq. 2).
-  torch::Tensor log_prob(const float* raw_obs, const float* actions, int64_t n);
-  // Starts the actor from a trained policy (weights and observation normaliser); the log
-  // std keeps its initial value. A transition policy can start as pi_b, whose behaviour it
-  // is trained to match. The actor may have more outputs than the policy (Lee et al.'s
-  // termination head): those start at zero weight and bias (set_action_bias sets one). The
-  // policy may see a prefix of the trainer's observation (a walker skill, before the
-  // obstacle pair): the other inputs start at zero weight, so the actor begins as exactly
-  // that policy.
-  void init_actor(const Policy& policy);
-  // Sets the bias of one action dimension's mean (the output layer's), e.g. where Lee et
-  // al.'s termination head starts, whether the actor began as a policy or at random.
-  void set_action_bias(int dim, float bias);
-  // Sets every action dimension's log std: a run continued from a converged checkpoint
-  // has next to no exploration left (PPO here has no entropy bonus).
-  void set_log_std(double log_std);
-  // Anneals the learning rate from here to total_steps, rather than over the whole budget
-  // from step 0: a stage continued from another run's checkpoint gets the full rate for
-  // its own steps. Saved with the checkpoint, so a resumed stage keeps its schedule.
-  void restart_lr_schedule() { schedule_start_ = iteration_; }
+  // Epochs of minibatch steps of Adam on L^CLIP + vf_coef L^VF - ent_coef H.
+  void update(IterationStats& stats) override;
+  std::vector<std::string> update_columns() const override {
+    return {"policy_loss", "value_loss", "entropy", "approx_kl", "clip_fraction"};
+  }
+  std::vector<double> update_values(const IterationStats& s) const override {
+    return {s.policy_loss, s.value_loss, s.entropy, s.approx_kl, s.clip_fraction};
+  }
   double learning_rate() const;  // the rate the last update used
 
-  // Checkpoint: network, optimiser, normalisers, counters and `note` (the resolved
-  // recipe), written atomically; with several ranks, save() and load() are collectives:
-  // rank 0 writes (every rank's episodes in flight gathered in environment order, so the
-  // file is the one a single process writes) and reads (the bytes sent to every rank). `extra` adds an owner's state (a discriminator) to the
-  // same file, so the two can never be saved at different iterations.
-  using ArchiveWriter = std::function<void(torch::serialize::OutputArchive&)>;
-  using ArchiveReader = std::function<void(torch::serialize::InputArchive&)>;
-  // The episodes in flight are saved too where every environment can say its state
-  // (Env::save_episode), and a load with `resume_episodes` puts them back, so a resumed
-  // run is the unbroken one; otherwise, or loading another run's checkpoint to continue
-  // from, the environments start fresh episodes.
-  void save(const std::string& path, const std::string& note = "", const ArchiveWriter& extra = {}) const;
-  void load(const std::string& path, const ArchiveReader& extra = {}, bool resume_episodes = true);
-  static Policy policy_from_checkpoint(const std::string& path);
-
  private:
-  void read_state(torch::serialize::InputArchive& ar, const std::string& path);  // load()'s body
-  struct InFlight;
-  void sample_actions(int t);
-  void refresh_inference_copy();
-  // The networks' input for one raw observation: normalised, then the periodic features.
-  void net_input(const float* raw, float* out) const;
-
   PpoConfig cfg_;
-  VectorEnv& envs_;
-  ActorCritic net_{nullptr};
-  std::unique_ptr<torch::optim::Adam> optimizer_;
-  EigenMlp actor_copy_;  // Eigen mirror of net_->actor for the rollout
-  RunningMeanStd obs_rms_, return_rms_;
-  RolloutBuffer buf_;
-  const Distributed& group_;
-  int64_t global_envs_;          // environments over every rank
-  std::vector<Rng> env_rng_;     // action noise, one stream per environment (any rank layout draws alike)
-  std::vector<float> return_samples_;  // the discounted returns of a rollout, for return_rms_
-  uint64_t seed_;
-  std::vector<double> running_return_;  // discounted return per env, for reward scaling
-  std::vector<float> mean_, log_std_;
-  std::vector<float> noise_;       // the standard normal draw each env's action adds [N, A]
-  std::vector<int> noise_age_;     // steps since that draw, reset when an episode ends
-  RewardHook reward_hook_;
-  int64_t iteration_ = 0, global_step_ = 0;
-  int64_t schedule_start_ = 0;  // the iteration the learning-rate annealing starts from
-  double wall_seconds_ = 0.0;
 };
 
 }  // namespace segue

@@ -19,7 +19,7 @@ torch::Tensor value_loss(const torch::Tensor& value, const torch::Tensor& return
 // sum_j relu(mu_j - high_j)^2 + relu(low_j - mu_j)^2. Actions are clamped to the bounds,
 // so a mean far outside them makes exploration noise a no-op in that dimension, and PPO
 // can try nothing there (stage 3's jump: its mean is outside [-1, 1] in 41-81% of its
-// steps, per dimension; experiments/lab/primitives/walker_jump_bounded.yaml). Penalising the
+// steps, per dimension; experiments/primitives/walker_jump.yaml, stage `bounded`). Penalising the
 // excursion (the "bounds loss" of rl_games-style PPO) keeps the deterministic action the
 // same while the noise stays live.
 torch::Tensor action_bound_loss(const torch::Tensor& mean, const torch::Tensor& low,

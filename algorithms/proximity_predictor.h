@@ -15,7 +15,7 @@ namespace segue {
 
 struct ProximitySpec {
   int obs_dim = 0;
-  std::vector<int> hidden{96, 96};  // 2 x 96 ReLU (spec)
+  std::vector<int> hidden{96, 96};  // 2 x 96 ReLU, the reference's (docs/reference/learners.md)
   double decay = 0.95;
 };
 

@@ -11,7 +11,7 @@ namespace segue {
 
 struct SwitchQSpec {
   int obs_dim = 0;
-  std::vector<int> hidden{128, 128};  // 2 x 128 ReLU (spec)
+  std::vector<int> hidden{128, 128};  // 2 x 128 ReLU, the reference's (docs/reference/learners.md)
   double gamma = 0.99;
 };
 

@@ -22,7 +22,7 @@ class Rng {
   void seed(uint64_t s) { engine_.seed(s); }
   // Uniform in [lo, hi).
   double uniform(double lo, double hi) { return lo + (hi - lo) * unit_(engine_); }
-  // The spec's U(a): uniform in [-a, a].
+  // U(a) of docs/reference/ (e.g. tasks.md#conventions): uniform in [-a, a].
   double symmetric(double a) { return uniform(-a, a); }
   double normal() { return normal_(engine_); }
   bool bernoulli(double p) { return unit_(engine_) < p; }

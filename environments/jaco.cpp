@@ -141,8 +141,9 @@ double JacoEnv::control_cost(const float* a) const {
   return -cfg_.ctrl_cost * ctrl - cfg_.qvel_cost * vel / model_->nv - cfg_.qacc_cost * acc / model_->nv;
 }
 
-// jaco.md §2: qpos, qvel clipped to +-30, raw qacc, hand position. Without rotation the
-// object's quaternion and angular velocity are left out (12 of each instead of 16/15/15).
+// docs/reference/jaco.md#observation: qpos, qvel clipped to +-30, raw qacc, hand position.
+// Without rotation the object's quaternion and angular velocity are left out (12 of each
+// instead of 16/15/15).
 void JacoEnv::observe(float* obs) const {
   const int np = with_rotation_ ? model_->nq : kArmDof + 3;
   const int nv = with_rotation_ ? model_->nv : kArmDof + 3;

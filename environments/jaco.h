@@ -1,7 +1,7 @@
 #pragma once
 // The Kinova Jaco arm (assets/jaco/) and what every arm task shares: the observation, the
 // hand position, the in-hand / in-air tests, the control cost, the randomised start and the
-// catch throw. Facts and reference values from ../shared/spec/jaco.md; every number can be
+// catch throw. Facts and reference values from docs/reference/jaco.md; every number can be
 // changed from a recipe's `env:` section.
 #include <array>
 
@@ -17,8 +17,8 @@ struct JacoConfig {
   int max_episode_steps = 200;
   double init_noise = 0.01;    // arm qpos, qvel + U(init_noise) at the start
   int init_random_steps = 10;  // then this many uniformly random actions, not counted
-  // Control cost (jaco.md §2): ctrl_cost sum a^2 + qvel_cost mean|qvel| + qacc_cost mean|qacc|,
-  // the means over all 15 DoF, the object's included.
+  // Control cost (docs/reference/jaco.md#control-cost): ctrl_cost sum a^2 + qvel_cost
+  // mean|qvel| + qacc_cost mean|qacc|, the means over all 15 DoF, the object's included.
   double ctrl_cost = 1e-4;
   double qvel_cost = 1e-8;
   double qacc_cost = 1e-8;

@@ -1,7 +1,7 @@
 #pragma once
-// The arm's four sub-tasks (../shared/spec/jaco.md §3): pick, catch, toss, hit. Each rule is
-// a small struct (its settings, its bookkeeping, one step of scoring) so that the composite
-// tasks, which run the same rules in sequence or repeatedly, reuse them unchanged.
+// The arm's four sub-tasks (docs/reference/jaco.md#sub-tasks): pick, catch, toss, hit. Each
+// rule is a small struct (its settings, its bookkeeping, one step of scoring) so that the
+// composite tasks, which run the same rules in sequence or repeatedly, reuse them unchanged.
 #include <type_traits>
 
 #include "environments/jaco.h"
@@ -108,7 +108,8 @@ struct TossRule {
   };
   Config cfg;
   State s;
-  // Serve judges the toss when the ball comes down to the hit instead (jaco.md §4): the
+  // Serve judges the toss when the ball comes down to the hit instead
+  // (docs/reference/tasks.md#serve): the
   // landing is then not scored.
   bool judge_landing = true;
 

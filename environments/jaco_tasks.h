@@ -1,5 +1,5 @@
 #pragma once
-// The arm's composite tasks (../shared/spec/jaco.md §4): the sub-tasks' rules run again and
+// The arm's composite tasks (docs/reference/tasks.md#arm-tasks): the sub-tasks' rules run again and
 // again, or in sequence. Each declares the features its transition intervals are written in;
 // the recipes (experiments/<task>.yaml) say which skill runs where.
 #include "environments/jaco_skills.h"

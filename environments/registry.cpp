@@ -163,7 +163,7 @@ Builder jaco_skill(const std::string& model, bool with_rotation, double init_noi
   };
 }
 
-// The arm's composite tasks (jaco.md §4): start noise 0.005, no random steps.
+// The arm's composite tasks (docs/reference/tasks.md#arm-tasks): start noise 0.005, no random steps.
 JacoConfig jaco_composite(const Section& env, int max_steps, int random_steps = 0) {
   JacoConfig d;
   d.init_noise = 0.005;
@@ -220,7 +220,8 @@ const std::map<std::string, Builder>& builders() {
       {"hurdle", walker_course(hurdle_layout(), 5000)},
       {"obstacle_course", walker_course(obstacle_course_layout(), 5000)},
       {"patrol", walker_patrol},
-      // jaco.md §3: pick and catch see the box's rotation (49 numbers), toss and hit do not (39).
+      // Pick and catch see the box's rotation (49 numbers), toss and hit do not (39):
+      // docs/reference/jaco.md#observation.
       {"jaco_pick", jaco_skill<PickRule>("jaco/jaco_box.xml", true, 0.01, 10)},
       {"jaco_catch", jaco_skill<CatchRule>("jaco/jaco_box.xml", true, 0.01, 10)},
       {"jaco_toss", jaco_skill<TossRule>("jaco/jaco_ball.xml", false, 0.005, 0)},

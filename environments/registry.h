@@ -1,5 +1,5 @@
 #pragma once
-// Task names (../shared/spec/environments.md) to environment constructors. A task's
+// Task names (docs/reference/tasks.md#task-names) to environment constructors. A task's
 // parameters come from the recipe's `env:` section; every key has the reference default.
 #include <memory>
 #include <string>

@@ -1,7 +1,7 @@
 #pragma once
 // The planar walker (assets/walker/walker.xml) and what every walker task shares: the
 // 26-number observation, the reference reward terms, the randomised start and the
-// random pushes. Reference values come from ../shared/spec/environments.md and can be
+// random pushes. Reference values come from docs/reference/walker.md and can be
 // changed from a recipe's `env:` section.
 #include <cmath>
 
@@ -18,7 +18,7 @@ struct WalkerConfig {
   double push_prob = 0.2;       // chance per control step of a push on a random body
   double push_force = 100.0;    // horizontal push force ~ U(push_force) newtons
   double fall_height = 0.8;     // torso z below this ends the episode
-  // Reward terms (spec: "shared reward terms").
+  // Reward terms (docs/reference/walker.md#reward-terms).
   double target_speed = 3.0;    // v' = target - |v - target|
   double height_target = 1.1;   // -|height_target - delta_h|
   double upright_weight = 0.1;  // + upright_weight cos(pitch)

@@ -1,6 +1,7 @@
 #pragma once
 // Hurdle and Obstacle course: the walker crosses a row of curbs and ceilings. Both are
-// this one class with a different layout (recipe `env:` keys), as the spec describes:
+// this one class with a different layout (recipe `env:` keys), as the reference describes
+// (docs/reference/tasks.md#walker-tasks):
 //   Hurdle:          curbs at 8, 18, ..., 48 (+ U(position_noise))
 //   Obstacle course: 3 curbs and 2 ceilings in random order at 8, 19, ..., 52 (+ U(0.5))
 // An obstacle counts when x is pass_margin past its end (a ceiling: ceiling_pass_margin).
@@ -18,9 +19,9 @@ class WalkerCourse : public WalkerObstacleEnv {
     bool shuffle = false;                // random order of `kinds` each episode
     double pass_bonus = 10.0;            // reward per obstacle passed
     // The reference code's Hurdle reward, which its Single baseline trains on (about 600
-    // per curb with pass_bonus 200; ../shared/spec/walker-reference-code.md): the speed and
+    // per curb with pass_bonus 200; docs/reference/tasks.md#hurdle): the speed and
     // height terms' weights (doubled there), + cross_bonus once each as the trailing foot
-    // (the spec's "lower foot", taken as the jump's) passes a curb's start, centre and end,
+    // (the reference's "rearmost foot", taken as the jump's) passes a curb's start, centre and end,
     // + mark_upward_weight clip(vz, -2, 2) as the torso passes each of them (WalkerJump's
     // terms of the same names). Defaults: ours.
     double speed_weight = 1.0, height_weight = 1.0;

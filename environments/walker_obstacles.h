@@ -142,7 +142,7 @@ class WalkerJump : public WalkerObstacleEnv {
     // clearing jump starts from; - close_stance_cost each step a foot stands between the
     // zone and the curb, too close to clear it. Stage 3's hop clears the curb exactly
     // when its last stance is in [-1.23, -0.59] and touches it from every other (the
-    // experiments/results/NOTES.md, Jump: probe_jump_failures): it does not place its take-off.
+    // jump's curriculum in docs/history.md): it does not place its take-off.
     double takeoff_bonus = 0.0, close_stance_cost = 0.0;
     std::array<double, 2> takeoff_zone = {-1.2, -0.6};
     double stance_height = 0.08;

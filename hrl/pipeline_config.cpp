@@ -20,7 +20,7 @@ CollectConfig CollectConfig::read(const Section& s) {
 
 TransitionPolicyConfig TransitionPolicyConfig::read(const Section& s, int obs_dim) {
   TransitionPolicyConfig c;
-  c.ppo.lr = 1e-4;  // policy Adam 1e-4 (spec)
+  c.ppo.lr = 1e-4;  // policy Adam 1e-4, the paper's text (docs/reference/learners.md)
   c.ppo.total_steps = 1'000'000;
   c.ppo.steps_per_env = 256;
   c.ppo.minibatch_size = 512;

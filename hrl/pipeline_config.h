@@ -1,6 +1,6 @@
 #pragma once
 // The settings of `segue run`'s stages, read from a composite recipe (every key has a
-// default: the spec's where it gives one):
+// default: where docs/reference/learners.md records one, the paper's text or its code's):
 //
 //   run_dir: runs/hurdle
 //   seed: 1
@@ -28,7 +28,7 @@ struct CollectConfig {
 
 struct TransitionPolicyConfig {
   PpoConfig ppo;                 // the generator's PPO
-  ActorCriticSpec net;           // 2 x 32 tanh, as the skills (spec)
+  ActorCriticSpec net;           // 2 x 32 tanh, as the skills (the paper's text)
   bool init_from_next = true;    // start pi_ab as a copy of pi_b (false: random, as the paper)
   // The generator's reward from D.
   //   "airl": Eq. 3, log D - log(1 - D) = f - log pi.
@@ -42,7 +42,7 @@ struct TransitionPolicyConfig {
   // the reward to ~0 once D is confident, which it is at first.
   std::string reward = "airl_absorbing";
   DiscriminatorSpec discriminator;
-  double disc_lr = 3e-4;         // Adam (spec)
+  double disc_lr = 3e-4;         // Adam (paper and code)
   int disc_batch = 256;          // expert and generator rows per discriminator step, each
   int disc_steps = 16;           // discriminator steps per PPO iteration
   double gradient_penalty = 0.0; // weight of Discriminator::gradient_penalty in D's loss (0: off, the paper's)
@@ -55,12 +55,13 @@ struct TransitionPolicyConfig {
   ActorCriticSpec network(const EnvSpec& env, const Policy& next) const;
 };
 
+// Network and learning as the reference's (docs/reference/learners.md#switch-network).
 struct SwitchConfig {
-  SwitchQSpec net;               // 2 x 128 ReLU (spec)
-  double lr = 1e-4;              // Adam (spec)
-  int batch = 64;                // minibatch (spec)
-  int replay = 1'000'000;        // replay capacity (spec)
-  int target_every = 500;        // updates between hard target copies (spec)
+  SwitchQSpec net;               // 2 x 128 ReLU
+  double lr = 1e-4;              // Adam
+  int batch = 64;                // minibatch
+  int replay = 1'000'000;        // replay capacity
+  int target_every = 500;        // updates between hard target copies
   double r_success = 1.0, r_fail = -1.0;
   int attempts = 2000;           // transition attempts (episodes of Alg. 2)
   int updates_per_attempt = 8;
@@ -104,7 +105,7 @@ struct SwitchConfig {
 // these are its proximity predictor's and termination head's settings.
 struct LeeConfig {
   bool enabled = true;         // train the baseline in `segue run`
-  std::vector<int> hidden{96, 96};  // P: 2 x 96 ReLU (spec)
+  std::vector<int> hidden{96, 96};  // P: 2 x 96 ReLU, the reference's
   double lr = 3e-4;            // Adam, least squares
   int batch = 64;
   int steps = 32;              // predictor steps per PPO iteration

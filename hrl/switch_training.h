@@ -2,9 +2,10 @@
 // Algorithm 2: the switch Q-network q_ab, which decides during a transition interval when
 // pi_ab hands control to pi_b. An attempt starts from a state of S_a; at every state q_ab
 // picks stay (pi_ab acts one step) or switch (pi_b takes over and runs its subtask).
-// Rewards (spec): switch -> r_s if pi_b then achieves its subtask, r_f if it fails;
-// stay -> r_f on a fall, else 0. How far "its subtask" reaches is config.lookahead
-// (run_subtask below). Every reward but the uneventful stay ends the attempt.
+// Rewards (docs/reference/learners.md#switch-network): switch -> r_s if pi_b then
+// achieves its subtask, r_f if it fails; stay -> r_f on a fall, else 0. How far "its
+// subtask" reaches is config.lookahead (run_subtask below). Every reward but the
+// uneventful stay ends the attempt.
 // Where the interval runs out while staying, control passes to pi_b as it does when the
 // method runs (the forced switch), and that last stay is valued by pi_b's outcome. The
 // paper's Algorithm 2 gives r_f there instead, which teaches q_ab that switching at any

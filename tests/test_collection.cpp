@@ -67,7 +67,8 @@ class CollectionFiles : public TempDirTest {
  protected:
   CollectionFiles() : TempDirTest("collect") {}
   // Hurdle (walk->jump's T_b from the windows the jump succeeds from) with stage 13's 38%
-  // jump, and `expert_extra` (", key: value") added to walk->jump's expert.
+  // jump (a test fixture: its failures are what the filter drops), and `expert_extra`
+  // (", key: value") added to walk->jump's expert.
   CompositeRecipe hurdle_with_stage13_jump(const std::string& expert_extra) {
     std::string text = read_file(CompositeRecipe::default_file("hurdle"));
     const std::string expert = "successful: true";  // walk -> jump's expert section
@@ -76,7 +77,7 @@ class CollectionFiles : public TempDirTest {
       throw Error("hurdle.yaml no longer has '" + expert + "' and '" + shipped + "'");
     text.insert(text.find(expert) + expert.size(), expert_extra);
     text.replace(text.find(shipped), shipped.size(),
-                 "jump: {policy: assets/policies/walker/archive/walker_jump_stage13.pt}");
+                 "jump: {policy: tests/data/walker_jump_stage13.pt}");
     std::ofstream(path("hurdle.yaml")) << text;
     return CompositeRecipe::load(path("hurdle.yaml"));
   }

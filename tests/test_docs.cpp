@@ -1,9 +1,13 @@
 // The documentation and the shipped recipes against the code: docs/recipes.md is exactly
-// what `segue keys` prints from the loaders, and every recipe under experiments/ (the lab
-// aside) loads and passes every check (`--check`), each stage of a curriculum included.
+// what `segue keys` prints from the loaders, and every recipe under experiments/ loads and
+// passes every check (`--check`), each stage of a curriculum included.
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cstdio>
 #include <filesystem>
+#include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -50,6 +54,86 @@ TEST(Docs, EveryShippedRecipeLoadsAndValidates) {
     }
   }
   EXPECT_GE(checked, 15);
+}
+
+// The repository stands alone: no tracked file points outside it, neither to a folder beside
+// the checkout nor to a path on one machine; the reference facts the code relies on are in
+// docs/reference/. Skipped: binaries, and this file, which spells the patterns.
+TEST(Docs, NoFileRefersOutsideTheRepository) {
+  namespace fs = std::filesystem;
+  const fs::path root = fs::path(SEGUE_SOURCE_DIR);
+  // Built from pieces so that the patterns do not spell themselves here.
+  const std::string dot_dot = "..";
+  const std::vector<std::string> patterns = {dot_dot + "/shared", "/" + std::string("work/"),
+                                             "/" + std::string("tmp/"), "/" + std::string("home/"),
+                                             "/" + std::string("root/")};
+  // The tracked files, or, outside a git checkout, every file below the source tree.
+  std::vector<std::string> files;
+  const std::string cmd = "git -C '" + root.string() + "' ls-files -z 2>/dev/null";
+  if (FILE* p = popen(cmd.c_str(), "r")) {
+    std::string listing;
+    std::array<char, 4096> buf;
+    size_t n;
+    while ((n = fread(buf.data(), 1, buf.size(), p)) > 0) listing.append(buf.data(), n);
+    if (pclose(p) == 0)
+      for (size_t begin = 0, end; (end = listing.find('\0', begin)) != std::string::npos; begin = end + 1)
+        files.push_back(listing.substr(begin, end - begin));
+  }
+  if (files.empty()) {
+    const auto options = fs::directory_options::skip_permission_denied;
+    for (auto it = fs::recursive_directory_iterator(root, options); it != fs::recursive_directory_iterator(); ++it) {
+      const std::string name = it->path().filename().string();
+      const bool skipped = name == ".git" || (it.depth() == 0 && (name.rfind("build", 0) == 0 || name == "runs"));
+      if (it->is_directory() && skipped) {
+        it.disable_recursion_pending();
+        continue;
+      }
+      if (it->is_regular_file()) files.push_back(fs::relative(it->path(), root).generic_string());
+    }
+  }
+  int checked = 0;
+  for (const std::string& file : files) {
+    if (file == "tests/test_docs.cpp") continue;
+    const std::string ext = fs::path(file).extension().string();
+    if (ext == ".pt" || ext == ".png" || ext == ".mp4") continue;
+    if (!fs::is_regular_file(root / file)) continue;  // deleted in the working tree
+    const std::string text = read_file((root / file).string());
+    if (text.substr(0, 8192).find('\0') != std::string::npos) continue;  // binary
+    ++checked;
+    std::istringstream lines(text);
+    int number = 0;
+    for (std::string line; std::getline(lines, line);) {
+      ++number;
+      for (const std::string& pattern : patterns)
+        if (line.find(pattern) != std::string::npos)
+          ADD_FAILURE() << file << ":" << number << ": refers outside the repository (" << pattern
+                        << "); point into docs/reference/ or the repository instead: " << line;
+    }
+  }
+  EXPECT_GT(checked, 100) << "the file listing found too few files below " << root;
+}
+
+// The README's import order, checked: environments/ and algorithms/ include only core/
+// (and themselves), hrl/ does not include tools/, core/ includes no other folder.
+TEST(Docs, IncludesRunOneWay) {
+  namespace fs = std::filesystem;
+  const fs::path root(SEGUE_SOURCE_DIR);
+  const std::map<std::string, std::set<std::string>> allowed{{"core", {"core"}},
+                                                             {"environments", {"core", "environments"}},
+                                                             {"algorithms", {"core", "algorithms"}},
+                                                             {"hrl", {"core", "environments", "algorithms", "hrl"}}};
+  int includes = 0;
+  for (const auto& [folder, may] : allowed)
+    for (const auto& entry : fs::directory_iterator(root / folder)) {
+      std::istringstream lines(read_file(entry.path().string()));
+      for (std::string line; std::getline(lines, line);) {
+        if (line.rfind("#include \"", 0) != 0) continue;
+        const std::string target = line.substr(10, line.find('/', 10) - 10);
+        ++includes;
+        EXPECT_TRUE(may.count(target)) << folder << "/" << entry.path().filename().string() << " includes " << line;
+      }
+    }
+  EXPECT_GT(includes, 100);
 }
 
 }  // namespace segue

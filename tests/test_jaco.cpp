@@ -1,4 +1,4 @@
-// The Jaco arm against ../shared/spec/jaco.md: kinematics at q = 0, masses, free fall, the
+// The Jaco arm against docs/reference/jaco.md: kinematics at q = 0, masses, free fall, the
 // catch throw, the toss's launch speed, each sub-task's reward and success by hand on a
 // scripted state sequence, failure paths, exact snapshots, and PPO learning to pick.
 #include <gtest/gtest.h>
@@ -25,7 +25,8 @@ TEST(Jaco, JointAnchorsAndAxesAtZeroMatchTheSpec) {
   mj_resetData(env->model(), d);
   env->forward(obs.data());
   struct Row { const char* joint; Vec3 anchor, axis; };
-  // jaco.md §1.2, "world axis / anchor at q=0" (finger axes are not in the table).
+  // docs/reference/jaco.md#kinematic-tree, the world axes and anchors at q = 0 (finger axes are
+  // not in the table).
   const Row rows[] = {
       {"jaco_joint_1", {0, 0, 0.4035}, {0, 0, 1}},
       {"jaco_joint_2", {0, 0, 0.522}, {0, 1, 0}},
@@ -65,12 +66,13 @@ TEST(Jaco, MassesHandPositionAndFingerSpan) {
   std::vector<float> obs(49);
   mj_resetData(m, env->mutable_data());
   env->forward(obs.data());
-  // jaco.md §2: the mean of the mesh centroids at q = 0.
+  // docs/reference/jaco.md#hand-position: the mean of the mesh centroids at q = 0.
   EXPECT_LT(distance(env->hand_pos(), {0.3963, 0.2345, 0.2815}), 0.01);
   // The observation ends with it.
   EXPECT_FLOAT_EQ(obs[46], float(env->hand_pos()[0]));
   EXPECT_FLOAT_EQ(obs[48], float(env->hand_pos()[2]));
-  // Tip-to-centroid radius of the three fingers: 0.083 open, 0.019 closed (§1.2).
+  // Tip-to-centroid radius of the three fingers: 0.083 open, 0.019 closed
+  // (docs/reference/jaco.md#link-lengths-and-the-zero-pose).
   auto radius = [&](double q) {
     mjData* d = env->mutable_data();
     for (int f = 6; f < 9; ++f) d->qpos[f] = q;
@@ -138,8 +140,8 @@ TEST(Jaco, ABoxFallsFreelyAsBallisticsSays) {
 }
 
 TEST(Jaco, CatchThrowFlightMatchesTheSpec) {
-  // jaco.md §3: the box falls from (0, 2, 1.5) for 10 random steps (to z 1.468, vz -0.785),
-  // then 110 N for one step gives |v| ~ 4.2 m/s toward the base centre + (0.45, 0.35, 1)
+  // docs/reference/jaco.md#catch: the box falls from (0, 2, 1.5) for 10 random steps (to z
+  // 1.468, vz -0.785), then 110 N for one step gives |v| ~ 4.2 m/s toward the base centre + (0.45, 0.35, 1)
   // (aim spread off here: the middle of the reference's range); with the arm out of the
   // way it lands ~54 steps later near (0.47, 0.29).
   auto env = make_arm<JacoCatch>("jaco_catch", "{aim: [0.45, 0.35, 1.0], aim_spread: 0}");
@@ -176,7 +178,7 @@ TEST(Jaco, CatchThrowFlightMatchesTheSpec) {
 
 TEST(Jaco, PickRewardsAndSuccessByHand) {
   // The box, its contacts off, is pinned in the hand 0.1 m up for 50 steps: the pick
-  // succeeds on the 50th with the terms of jaco.md §3.
+  // succeeds on the 50th with the terms of docs/reference/jaco.md#sub-tasks.
   auto env = make_arm<JacoPick>("jaco_pick", "{init_random_steps: 0}");
   object_contacts_off(*env);
   std::vector<float> obs(49), zero(9, 0.0f);
@@ -304,8 +306,9 @@ TEST(Jaco, CatchCountsHeldStepsCumulatively) {
 
 TEST(Jaco, TossLaunchSpeedApexAndLandingByHand) {
   // A ball launched from the release height 0.7 at 5.05 m/s straight up peaks at
-  // 0.7 + v^2 / 2g = 2.0 (jaco.md §3) and lands back where it started: release +50, apex
-  // 50 (1 - |2 - z| / 2) + 50, landing +100, and the guide's telescoped 100 (d0 - d_end).
+  // 0.7 + v^2 / 2g = 2.0 (docs/reference/jaco.md#toss) and lands back where it started:
+  // release +50, apex 50 (1 - |2 - z| / 2) + 50, landing +100, and the guide's telescoped
+  // 100 (d0 - d_end).
   auto env = make_arm<JacoToss>("jaco_toss");
   arm_contacts_off(*env);
   std::vector<float> obs(39), zero(9, 0.0f);

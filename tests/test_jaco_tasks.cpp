@@ -1,4 +1,4 @@
-// The arm's composite tasks against ../shared/spec/jaco.md §4, on scripted state sequences:
+// The arm's composite tasks against docs/reference/tasks.md#arm-tasks, on scripted state sequences:
 // Repetitive picking re-places the box after each success and ends at five; Repetitive
 // catching pins the next box at its start and throws it; Serve judges the toss and then
 // counts the hit. And the meta-controller on a task whose skill hands over to itself.
@@ -104,7 +104,7 @@ TEST(RepetitiveCatching, PinsTheNextBoxAtTheStartThenThrowsIt) {
   env->reset(2, obs.data());
   const std::vector<std::string> names = {"steps", "object_z", "successes", "since_success", "since_throw", "waiting"};
   ASSERT_EQ(env->spec().feature_names, names);
-  // The first box was thrown at reset, toward the arm (about 4.2 m/s, jaco.md §7).
+  // The first box was thrown at reset, toward the arm (about 4.2 m/s, docs/reference/jaco.md#catch).
   const Vec3 v0 = env->object_velocity();
   EXPECT_NEAR(std::sqrt(v0[0] * v0[0] + v0[1] * v0[1] + v0[2] * v0[2]), 4.2, 0.4);
   EXPECT_EQ(features_of(*env)[4], 0);  // since_throw

@@ -1,16 +1,17 @@
-// kill -9 at random moments: a tiny PPO run killed twenty times (before its first
-// checkpoint, mid-rollout, mid-write, between a metrics row and its checkpoint) and rerun
-// each time ends with the unbroken run's policy.pt, byte for byte, and its rows.
+// kill -9 at moments defined by the run's own progress: a tiny PPO run killed twenty times
+// (before its first checkpoint, between a metrics row and its checkpoint, while a
+// checkpoint is being written, in the rollout after one) and rerun each time ends with the
+// unbroken run's policy.pt, byte for byte, and its rows. Every kill waits on the run
+// directory, never on the clock, so all twenty land on a machine of any speed.
 #include <gtest/gtest.h>
 
 #include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <chrono>
 #include <fstream>
 #include <sstream>
-#include <thread>
 
 #include "core/rng.h"
 #include "core/run_dir.h"
@@ -55,12 +56,31 @@ std::vector<std::string> rows(const std::string& file) {
   return out;
 }
 
-TEST_F(KillSoak, TwentyRandomKillsResumeToABitIdenticalPolicy) {
+size_t row_count(const std::string& file) {
+  std::ifstream in(file);
+  size_t n = 0;
+  for (std::string line; std::getline(in, line);) ++n;
+  return n > 0 ? n - 1 : 0;
+}
+
+// The checkpoint's inode: write_file_atomic renames a new file in, so it changes with
+// every checkpoint written (0 while there is none).
+ino_t inode(const std::string& file) {
+  struct stat st {};
+  return ::stat(file.c_str(), &st) == 0 ? st.st_ino : 0;
+}
+
+TEST_F(KillSoak, TwentyKillsAtRandomPointsOfProgressResumeToABitIdenticalPolicy) {
   const std::string unbroken = recipe("unbroken"), killed = recipe("killed");
   ASSERT_EQ(run_cli("train " + unbroken).code, 0);
+  const std::string metrics = path("killed") + "/metrics.csv", checkpoint = path("killed") + "/checkpoint.pt";
   Rng rng(20261202);
-  int kills = 0;
-  for (int attempt = 0; attempt < 60 && kills < 20; ++attempt) {
+  // The run has 90 iterations; a kill lets it advance at most three rows, so twenty kills
+  // land before it can finish, however fast or slow the machine.
+  for (int kill = 0; kill < 20; ++kill) {
+    const size_t rows_before = row_count(metrics);
+    const ino_t checkpoint_before = inode(checkpoint);
+    const int moment = rng.integer(0, 3), ahead = rng.integer(1, 2);
     const pid_t pid = fork();
     if (pid == 0) {
       freopen("/dev/null", "w", stdout);
@@ -68,18 +88,28 @@ TEST_F(KillSoak, TwentyRandomKillsResumeToABitIdenticalPolicy) {
       execl(SEGUE_BINARY, SEGUE_BINARY, "train", killed.c_str(), static_cast<char*>(nullptr));
       _exit(127);
     }
-    // Startup takes about half a second; the whole run a few.
-    std::this_thread::sleep_for(std::chrono::microseconds(int64_t(rng.uniform(0.3, 1.3) * 1e6)));
-    const bool alive = ::kill(pid, SIGKILL) == 0;
+    const size_t target = rows_before + ahead;
+    std::function<bool()> reached = [] { return true; };  // 0: at start-up, before any checkpoint of this life
+    if (moment == 1)  // just after a metrics row, before (or while) its checkpoint is written
+      reached = [&] { return row_count(metrics) >= target; };
+    else if (moment == 2)  // while a checkpoint's temporary file exists (or, missed, one row on)
+      reached = [&] {
+        return (row_count(metrics) >= rows_before + 1 && std::filesystem::exists(checkpoint + ".tmp")) ||
+               row_count(metrics) >= target + 1;
+      };
+    else if (moment == 3)  // in the rollout after a new checkpoint
+      reached = [&] { return inode(checkpoint) != checkpoint_before && inode(checkpoint) != 0; };
     int status = 0;
+    ASSERT_TRUE(wait_until(pid, reached, &status))
+        << "kill " << kill << " (moment " << moment << "): the run ended by itself, status " << status;
+    ASSERT_EQ(::kill(pid, SIGKILL), 0);
     ::waitpid(pid, &status, 0);
-    if (alive && WIFSIGNALED(status)) ++kills;
-    if (std::filesystem::exists(path("killed") + "/eval.json")) break;  // finished before the kill
+    ASSERT_TRUE(WIFSIGNALED(status)) << "kill " << kill << ": status " << status;
+    ASSERT_FALSE(std::filesystem::exists(path("killed") + "/eval.json")) << "the run finished before kill " << kill;
   }
-  EXPECT_EQ(kills, 20);
   ASSERT_EQ(run_cli("train " + killed).code, 0);
-  EXPECT_EQ(rows(path("killed") + "/metrics.csv"), rows(path("unbroken") + "/metrics.csv"));
-  EXPECT_EQ(rows(path("killed") + "/metrics.csv").size(), 46080u / 512);
+  EXPECT_EQ(rows(metrics), rows(path("unbroken") + "/metrics.csv"));
+  EXPECT_EQ(rows(metrics).size(), 46080u / 512);
   EXPECT_TRUE(read_file(path("killed") + "/policy.pt") == read_file(path("unbroken") + "/policy.pt"))
       << "policy.pt differs from the unbroken run's";
 }

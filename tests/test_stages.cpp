@@ -107,12 +107,11 @@ TEST_F(Stages, ARunStoppedInTheSecondStageResumesToTheUnbrokenRunsRows) {
   ASSERT_EQ(run_segue("train " + recipe(longer, "unbroken")), 0);
   const std::string file = recipe(longer, "stopped");
   pid_t pid = start_training(file);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (!std::filesystem::exists(path("stopped/2-second/checkpoint.pt")) && std::chrono::steady_clock::now() < deadline)
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  kill(pid, SIGTERM);
   int status = 0;
-  waitpid(pid, &status, 0);
+  if (wait_until(pid, [&] { return std::filesystem::exists(path("stopped/2-second/checkpoint.pt")); }, &status)) {
+    kill(pid, SIGTERM);
+    waitpid(pid, &status, 0);
+  }
   const bool stopped_in_stage_two = WIFEXITED(status) && WEXITSTATUS(status) == 128 + SIGTERM;
   EXPECT_TRUE(stopped_in_stage_two) << "status " << status << " (finished before the signal?)";
   if (stopped_in_stage_two) EXPECT_FALSE(std::filesystem::exists(path("stopped/2-second/eval.json")));

@@ -12,7 +12,7 @@
 #include <sstream>
 #include <unistd.h>
 
-#include "algorithms/skill_recipe.h"
+#include "hrl/skill_recipe.h"
 #include "core/assets.h"
 #include "core/mujoco_env.h"
 #include "core/rng.h"
@@ -145,7 +145,7 @@ int64_t replay(const mjModel* model, int frame_skip, const std::vector<Trajector
 }
 
 struct Rates {
-  double rollout, ppo, bare;
+  double rollout, full, bare;  // full: the learner's whole loop, rollout and update
 };
 
 // Every mj_step the environments ran, episode resets included.
@@ -157,30 +157,33 @@ int64_t physics_steps(VectorEnv& envs) {
 
 Rates rates(const SkillRecipe& s, int threads, int iterations) {
   set_torch_threads(1);  // as segue train: environments get the threads, LibTorch one
-  VectorEnv envs(s.make_env, s.ppo.num_envs, threads);
-  PPO ppo(s.ppo, s.net, envs, s.seed);
+  const int num_envs = s.num_envs();
+  VectorEnv envs(s.make_env, num_envs, threads);
+  const std::unique_ptr<OnPolicyLearner> learner(
+      dynamic_cast<OnPolicyLearner*>(make_learner(s, envs, Distributed::alone()).release()));
   IterationStats warm;
-  ppo.collect_rollout(warm);  // first-touch allocations and caches
+  learner->collect_rollout(warm);  // first-touch allocations and caches
   int64_t n0 = physics_steps(envs);
   auto t0 = std::chrono::steady_clock::now();
   for (int i = 0; i < iterations; ++i) {
     IterationStats st;
-    ppo.collect_rollout(st);
+    learner->collect_rollout(st);
   }
   const double rollout = (physics_steps(envs) - n0) / seconds_since(t0);
 
   // The same seed and settings again, recorded: rollouts are a pure function of the seed,
   // so these are the trajectories just timed.
-  std::vector<Trajectory> recorded(s.ppo.num_envs);
+  std::vector<Trajectory> recorded(num_envs);
   int next = 0;
-  VectorEnv rec_envs([&] { return std::make_unique<RecordingEnv>(s.make_env(), &recorded[next++]); },
-                     s.ppo.num_envs, threads);
-  PPO rec(s.ppo, s.net, rec_envs, s.seed);
-  rec.collect_rollout(warm);
+  VectorEnv rec_envs([&] { return std::make_unique<RecordingEnv>(s.make_env(), &recorded[next++]); }, num_envs,
+                     threads);
+  const std::unique_ptr<OnPolicyLearner> rec(
+      dynamic_cast<OnPolicyLearner*>(make_learner(s, rec_envs, Distributed::alone()).release()));
+  rec->collect_rollout(warm);
   for (int i = 0; i < rec_envs.size(); ++i) dynamic_cast<RecordingEnv&>(rec_envs.env(i)).restart_here();
   for (int i = 0; i < iterations; ++i) {
     IterationStats st;
-    rec.collect_rollout(st);
+    rec->collect_rollout(st);
   }
   auto probe = s.make_env();
   const auto& mj = dynamic_cast<const MujocoEnv&>(*probe);
@@ -190,7 +193,7 @@ Rates rates(const SkillRecipe& s, int threads, int iterations) {
 
   n0 = physics_steps(envs);
   t0 = std::chrono::steady_clock::now();
-  for (int i = 0; i < iterations; ++i) ppo.iterate();
+  for (int i = 0; i < iterations; ++i) learner->iterate();
   const double full = (physics_steps(envs) - n0) / seconds_since(t0);
   return {rollout, full, bare};
 }
@@ -262,26 +265,38 @@ int bench_main(int argc, char** argv) {
     SkillRecipe s = SkillRecipe::read(recipe, "runs/bench");
     recipe.reject_unknown();
     const Rates one = rates(s, 1, iterations), all = rates(s, cores, iterations);
+    // TRPO on the recipe's rollouts (its environments, steps and returns), with TRPO's
+    // own update settings.
+    SkillRecipe t = s;
+    t.learner = "trpo";
+    static_cast<OnPolicyConfig&>(t.trpo) = s.ppo;
+    const Rates trpo_one = rates(t, 1, iterations), trpo_all = rates(t, cores, iterations);
     const std::string p = robot == std::string("walker") ? "" : std::string(robot) + "_";
     for (const auto& [key, value] : std::vector<std::pair<std::string, double>>{
-             {"rollout_sps", one.rollout}, {"ppo_sps", one.ppo}, {"bare_sps", one.bare},
-             {"rollout_vs_bare", one.rollout / one.bare}, {"ppo_vs_bare", one.ppo / one.bare},
-             {"rollout_sps_all_cores", all.rollout}, {"ppo_sps_all_cores", all.ppo},
+             {"rollout_sps", one.rollout}, {"ppo_sps", one.full}, {"bare_sps", one.bare},
+             {"rollout_vs_bare", one.rollout / one.bare}, {"ppo_vs_bare", one.full / one.bare},
+             {"rollout_sps_all_cores", all.rollout}, {"ppo_sps_all_cores", all.full},
              {"bare_sps_all_cores", all.bare}, {"rollout_vs_bare_all_cores", all.rollout / all.bare},
-             {"ppo_vs_bare_all_cores", all.ppo / all.bare}})
+             {"ppo_vs_bare_all_cores", all.full / all.bare}, {"trpo_sps", trpo_one.full},
+             {"trpo_vs_bare", trpo_one.full / trpo_one.bare}, {"trpo_sps_all_cores", trpo_all.full},
+             {"trpo_vs_bare_all_cores", trpo_all.full / trpo_all.bare}})
       json.push_back({p + key, value});
     if (args.has("json")) continue;
     std::printf("%s (%s, %d envs)\n", robot, s.task.c_str(), s.ppo.num_envs);
     std::printf("  bare mj_step replay, 1 thread   %10.0f\n", one.bare);
     std::printf("  rollout + inference, 1 thread   %10.0f  %5.2f of bare  (target >= 0.85)\n", one.rollout,
                 one.rollout / one.bare);
-    std::printf("  full PPO loop, 1 thread         %10.0f  %5.2f of bare  (target >= 0.5)\n", one.ppo,
-                one.ppo / one.bare);
+    std::printf("  full PPO loop, 1 thread         %10.0f  %5.2f of bare  (target >= 0.8)\n", one.full,
+                one.full / one.bare);
+    std::printf("  full TRPO loop, 1 thread        %10.0f  %5.2f of bare  (target >= 0.8)\n", trpo_one.full,
+                trpo_one.full / trpo_one.bare);
     std::printf("  bare replay, %d cores            %10.0f  %5.2fx one thread\n", cores, all.bare, all.bare / one.bare);
     std::printf("  rollout, %d cores                %10.0f  %5.2f of bare, %5.2fx one thread\n", cores, all.rollout,
                 all.rollout / all.bare, all.rollout / one.rollout);
-    std::printf("  full PPO loop, %d cores          %10.0f  %5.2f of bare, %5.2fx one thread\n", cores, all.ppo,
-                all.ppo / all.bare, all.ppo / one.ppo);
+    std::printf("  full PPO loop, %d cores          %10.0f  %5.2f of bare, %5.2fx one thread  (target >= 0.85)\n",
+                cores, all.full, all.full / all.bare, all.full / one.full);
+    std::printf("  full TRPO loop, %d cores         %10.0f  %5.2f of bare, %5.2fx one thread  (target >= 0.85)\n",
+                cores, trpo_all.full, trpo_all.full / trpo_all.bare, trpo_all.full / trpo_one.full);
   }
   // Data parallelism: the walker's PPO on 1 and 2 ranks of one thread each, with the
   // recipe's minibatches and with one minibatch per epoch (the update's exchanges and

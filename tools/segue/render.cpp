@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "algorithms/policy.h"
-#include "algorithms/skill_recipe.h"
+#include "hrl/skill_recipe.h"
 #include "core/mujoco_env.h"
 #include "environments/registry.h"
 #include "tools/segue/cli.h"

@@ -1,5 +1,6 @@
-// segue train RECIPE: PPO on one task (or, with an `es` section, an evolution-strategy
-// fine-tuning of a trained policy), with a run directory that survives interruption.
+// segue train RECIPE: PPO or TRPO on one task (or, with an `es` section, an
+// evolution-strategy fine-tuning of a trained policy), with a run directory that survives
+// interruption.
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -16,7 +17,7 @@
 
 #include "hrl/evaluation.h"
 #include "hrl/lead_in.h"
-#include "algorithms/skill_recipe.h"
+#include "hrl/skill_recipe.h"
 #include "core/assets.h"
 #include "core/distributed.h"
 #include "core/progress.h"
@@ -30,14 +31,15 @@ namespace {
 const Command kTrain{
     "train",
     "RECIPE [--set key=value ...]",
-    "Trains a skill with PPO, or with an `es:` section fine-tunes init_policy with\n"
-    "evolution strategies. Writes the run directory (recipe.yaml, metrics.csv,\n"
+    "Trains a skill with the recipe's learner (PPO or TRPO), or with an `es:` section\n"
+    "fine-tunes init_policy with"
+    " evolution strategies. Writes the run directory (recipe.yaml, metrics.csv,\n"
     "checkpoint.pt, policy.pt, eval.json). Rerunning the same command after an\n"
     "interruption resumes from the last checkpoint; a finished run is only re-evaluated.",
     {"RECIPE"},
     {{"set", "key=value", "override a recipe key (repeatable), e.g. --set ppo.lr=1e-4", true},
      {"threads", "N", "threads for environments and LibTorch (overrides the recipe; 0 = all)"},
-     {"nproc", "N", "data-parallel PPO on N local ranks (c10d Gloo; see docs/distributed.md)"},
+     {"nproc", "N", "data-parallel PPO or TRPO on N local ranks (c10d Gloo; see docs/distributed.md)"},
      {"check", "", "read and check the recipe (every stage), then stop"}}};
 
 // The end of every run: export the policy, evaluate it on the recipe's eval task, write
@@ -183,7 +185,7 @@ namespace {
 
 // A curriculum: `stages:`, each a partial recipe laid over the rest of the file and run in
 // its own directory RUN_DIR/N-NAME. Stage N+1 continues stage N's checkpoint (network,
-// optimiser, normalisers, counters; its ppo.total_steps are its own steps), or with
+// optimiser, normalisers, counters; its learner's total_steps are its own steps), or with
 // `continue: policy` starts its actor as stage N's policy with a fresh critic. Finished
 // stages are skipped, so rerunning resumes inside the stage that was interrupted.
 struct Stage {
@@ -276,7 +278,7 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
   const std::vector<Stage> stages = read_stages(recipe);
   const std::string top = recipe.root().get("run_dir", default_run_dir);
   // Stage i's recipe: the file, the stage's keys over it, then where it starts from.
-  auto stage_recipe = [&](size_t i, const std::string& start, int64_t total_steps) {
+  auto stage_recipe = [&](size_t i, const std::string& start, int64_t total_steps, const std::string& learner) {
     YAML::Node ov = YAML::Clone(stages[i].overrides);
     ov["run_dir"] = stage_dir(top, i, stages[i]);
     // A later stage starts from the stage before only: the file's own start (its first
@@ -285,7 +287,7 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
       ov[stages[i].from_policy ? "init_policy" : "init_from"] = start;
       ov[stages[i].from_policy ? "init_from" : "init_policy"] = "";
     }
-    if (total_steps > 0) ov["ppo"]["total_steps"] = total_steps;
+    if (total_steps > 0) ov[learner]["total_steps"] = total_steps;
     return recipe.with_overrides(ov, recipe.file() + " (stage " + stages[i].name + ")");
   };
   // Every stage is read and checked before the first step of the first. The curriculum's
@@ -293,7 +295,7 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
   JobPlan plan;
   int64_t line_end = 0;
   for (size_t i = 0; i < stages.size(); ++i) {
-    const int64_t steps = read_skill(stage_recipe(i, "(the stage before)", 0), top).ppo.total_steps;
+    const int64_t steps = read_skill(stage_recipe(i, "(the stage before)", 0, ""), top).total_steps();
     line_end = i == 0 || stages[i].from_policy ? steps : line_end + steps;
     plan.add(stages[i].name, 1e-3 * double(line_end));
   }
@@ -310,15 +312,16 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
     }
     std::string start;
     int64_t total = 0;
+    const std::string learner = SkillRecipe::read(stage_recipe(i, "", 0, ""), top).learner;
     if (i > 0) {
       const std::string prev = stage_dir(top, i - 1, stages[i - 1]);
       start = prev + (stages[i].from_policy ? "/policy.pt" : "/checkpoint.pt");
       // Continuing a checkpoint: the stage's own steps on top of those it has done.
       if (!stages[i].from_policy)
         total = std::stoll(group.broadcast(group.leader() ? std::to_string(int64_t(eval_env_steps(prev + "/eval.json"))) : "")) +
-                SkillRecipe::read(stage_recipe(i, start, 0), top).ppo.total_steps;
+                SkillRecipe::read(stage_recipe(i, start, 0, learner), top).total_steps();
     }
-    const Recipe r = stage_recipe(i, start, total);
+    const Recipe r = stage_recipe(i, start, total, learner);
     spdlog::info("stage {}/{} '{}' in {}  (curriculum: {})", i + 1, stages.size(), stages[i].name, dir,
                  plan.summary());
     plan.begin(stages[i].name);
@@ -360,79 +363,87 @@ int train_skill(const Recipe& recipe, const SkillRecipe& s) {
     make_dir();
     return train_es(s, start, recipe, recipe_path, *dir, threads);
   }
-  const Shard share = group.shard(s.ppo.num_envs, recipe_path + ": key 'ppo.num_envs'");
+  if (s.learner == "sac" && !group.single())
+    throw Error(recipe_path + ": key 'learner': sac runs on one process (drop --nproc)");
+  const Shard share = group.shard(s.num_envs(), recipe_path + ": key '" + s.learner + ".num_envs'");
   VectorEnv envs(s.make_env, share.count, threads, share.first);
-  PPO ppo(s.ppo, s.net, envs, s.seed, group);
+  const std::unique_ptr<Learner> learner = make_learner(s, envs, group);
+  OnPolicyLearner* on_policy = dynamic_cast<OnPolicyLearner*>(learner.get());  // PPO, TRPO: null for SAC
+  const int64_t total_steps = s.total_steps();
   if (resume) {
     make_dir();  // first: a different recipe is refused before its checkpoint is read
-    ppo.load(checkpoint);
-    spdlog::info("resuming {} from iteration {} ({} steps)", s.run_dir, ppo.iteration(), ppo.global_step());
+    learner->load_checkpoint(checkpoint, /*resume=*/true);
+    spdlog::info("resuming {} from iteration {} ({} steps)", s.run_dir, learner->iteration(), learner->global_step());
   } else if (!s.init_from.empty()) {
     const std::string from = repo_path(s.init_from);
     if (group.leader() && !std::filesystem::exists(from))
       throw Error(recipe_path + ": key 'init_from': no such checkpoint '" + s.init_from + "'");
     try {
-      ppo.load(from, {}, /*resume_episodes=*/false);
+      learner->load_checkpoint(from, /*resume=*/false);
     } catch (const Error& e) {
       throw Error(recipe_path + ": key 'init_from': " + e.what());
     }
-    if (!std::isnan(s.init_log_std)) ppo.set_log_std(s.init_log_std);
-    if (s.restart_lr_schedule) ppo.restart_lr_schedule();
+    if (!std::isnan(s.init_log_std)) on_policy->set_log_std(s.init_log_std);
+    if (s.restart_lr_schedule) on_policy->restart_lr_schedule();
     spdlog::info("training {} in {} from {} (iteration {}, {} steps) to {} steps", s.task, s.run_dir, s.init_from,
-                 ppo.iteration(), ppo.global_step(), s.ppo.total_steps);
+                 learner->iteration(), learner->global_step(), total_steps);
   } else if (!s.init_policy.empty()) {
     const std::string key = recipe_path + ": key 'init_policy': '" + s.init_policy + "'";
     Policy start = load_init_policy(s, recipe_path, envs.spec(), /*prefix=*/true);
     try {
-      ppo.init_actor(start);
+      on_policy->init_actor(start);
     } catch (const Error& e) {
       throw Error(key + ": " + e.what());
     }
     spdlog::info("training {} in {} with the actor of {} to {} steps", s.task, s.run_dir, s.init_policy,
-                 s.ppo.total_steps);
+                 total_steps);
   } else if (group.single()) {
-    spdlog::info("training {} in {} ({} steps, {} threads)", s.task, s.run_dir, s.ppo.total_steps, threads);
+    spdlog::info("training {} in {} ({} steps, {} threads)", s.task, s.run_dir, total_steps, threads);
   } else {
-    spdlog::info("training {} in {} ({} steps) on {} ranks, {} threads each", s.task, s.run_dir, s.ppo.total_steps,
+    spdlog::info("training {} in {} ({} steps) on {} ranks, {} threads each", s.task, s.run_dir, total_steps,
                  group.size(), threads);
   }
   if (!resume) make_dir();
   std::optional<MetricsCsv> csv;
-  if (group.leader())
-    csv.emplace(dir->file("metrics.csv"),
-                std::vector<std::string>{"iteration", "global_step", "episodes", "episode_return", "episode_length",
-                                         "success_rate", "success_count", "policy_loss", "value_loss", "entropy",
-                                         "approx_kl", "clip_fraction", "rollout_seconds", "update_seconds",
-                                         "wall_seconds", "comm_seconds"},
-                ppo.iteration());
+  // The episode columns, the learner's own (update_columns()), then the timings.
+  const std::vector<std::string> timing_columns{"rollout_seconds", "update_seconds", "wall_seconds", "comm_seconds"};
+  if (group.leader()) {
+    std::vector<std::string> columns{"iteration",      "global_step",  "episodes",     "episode_return",
+                                     "episode_length", "success_rate", "success_count"};
+    for (const auto& c : learner->update_columns()) columns.push_back(c);
+    columns.insert(columns.end(), timing_columns.begin(), timing_columns.end());
+    csv.emplace(dir->file("metrics.csv"), columns, learner->iteration());
+  }
 
   const std::atomic<int>& stop = install_stop_signals();
   std::optional<Progress> progress;
-  if (group.leader()) progress.emplace(s.task, s.ppo.total_steps, ppo.global_step());
+  if (group.leader()) progress.emplace(s.task, total_steps, learner->global_step());
   double recent_return = NAN, recent_success = NAN;
-  while (ppo.global_step() < s.ppo.total_steps) {
-    IterationStats st = ppo.iterate();
+  while (learner->global_step() < total_steps) {
+    IterationStats st = learner->iterate();
     if (st.episodes > 0) recent_return = st.episode_return, recent_success = st.success_rate;
-    if (csv)
-      csv->write({double(st.iteration), double(st.global_step), double(st.episodes), st.episode_return,
-                  st.episode_length, st.success_rate, st.success_count, st.policy_loss, st.value_loss,
-                  st.entropy, st.approx_kl, st.clip_fraction, st.rollout_seconds, st.update_seconds,
-                  ppo.wall_seconds(), st.comm_seconds});
-    const bool last = ppo.global_step() >= s.ppo.total_steps;
+    if (csv) {
+      std::vector<double> row{double(st.iteration), double(st.global_step), double(st.episodes), st.episode_return,
+                              st.episode_length,    st.success_rate,        st.success_count};
+      for (double v : learner->update_values(st)) row.push_back(v);
+      for (double v : {st.rollout_seconds, st.update_seconds, learner->wall_seconds(), st.comm_seconds}) row.push_back(v);
+      csv->write(row);
+    }
+    const bool last = learner->global_step() >= total_steps;
     const bool stopping = group.any(stop != 0);  // every rank stops at the same iteration
-    if (last || stopping || st.iteration % s.checkpoint_every == 0) ppo.save(checkpoint, recipe.resolved_yaml());
-    if (progress) progress->update(ppo.global_step(), recent_return, recent_success);
+    if (last || stopping || st.iteration % s.checkpoint_every == 0) learner->save(checkpoint, recipe.resolved_yaml());
+    if (progress) progress->update(learner->global_step(), recent_return, recent_success);
     if (stopping && !last) {
       if (progress) progress->finish();
       spdlog::warn("interrupted: checkpoint saved at iteration {}; rerun the same command to resume",
-                   ppo.iteration());
+                   learner->iteration());
       return 128 + (stop ? stop.load() : SIGTERM);
     }
   }
   if (progress) progress->finish();
   uninstall_stop_signals();
   if (!group.leader()) return 0;  // rank 0 exports and evaluates
-  return finish_run(ppo.policy(), s, *dir, ppo.global_step(), ppo.wall_seconds(), threads);
+  return finish_run(learner->policy(), s, *dir, learner->global_step(), learner->wall_seconds(), threads);
 }
 
 }  // namespace

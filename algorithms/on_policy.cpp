@@ -1,0 +1,278 @@
+#include "algorithms/on_policy.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "algorithms/gae.h"
+#include "core/error.h"
+
+namespace segue {
+
+void OnPolicyConfig::read_rollout(const Section& s) {
+  // Sizes are bounded before anything is allocated: a typo of 1e9 environments must not
+  // exhaust memory.
+  total_steps = s.get("total_steps", total_steps, Range::positive());
+  num_envs = s.get("num_envs", num_envs, Range::closed(1, kMaxEnvs));
+  steps_per_env = s.get("steps_per_env", steps_per_env, Range::closed(1, kMaxStepsPerEnv));
+  gamma = s.get("gamma", gamma, Range::open_closed(0, 1));
+  lambda = s.get("lambda", lambda, Range::closed(0, 1));
+  min_log_std = s.get("min_log_std", min_log_std, Range::any());
+  noise_repeat = s.get("noise_repeat", noise_repeat, Range::positive());
+  normalize_reward = s.get("normalize_reward", normalize_reward);
+  obs_clip = s.get("obs_clip", obs_clip, Range::positive());
+}
+
+OnPolicyLearner::OnPolicyLearner(std::string name, const OnPolicyConfig& config, const ActorCriticSpec& net,
+                                 VectorEnv& envs, uint64_t seed, const Distributed& group)
+    : rollout_cfg_(config), envs_(envs), group_(group), seed_(seed), name_(std::move(name)),
+      obs_rms_(net.obs_dim, config.obs_clip), return_rms_(1), global_envs_(envs.size()) {
+  if (!group_.single()) {
+    double n = envs.size();
+    group_.sum(&n, 1);
+    global_envs_ = int64_t(n);
+    if (global_envs_ != rollout_cfg_.num_envs)
+      throw Error(name_ + ": the ranks step " + std::to_string(global_envs_) + " environments in all, " + name_ +
+                  ".num_envs is " + std::to_string(rollout_cfg_.num_envs));
+  }
+  torch::manual_seed(mix_seed(seed, 0x5e9e));
+  net_ = ActorCritic(net);
+  if (!net.ignore_obs.empty()) obs_rms_.ignore(net.ignore_obs.at(0), net.ignore_obs.at(1));
+  buf_.resize(rollout_cfg_.steps_per_env, envs.size(), net.obs_dim, net.act_dim, net.in_dim());
+  running_return_.assign(envs.size(), 0.0);
+  mean_.resize(size_t(envs.size()) * net.act_dim);
+  noise_.resize(size_t(envs.size()) * net.act_dim);
+  noise_age_.assign(envs.size(), 0);
+  env_rng_.resize(envs.size());
+  return_samples_.resize(size_t(rollout_cfg_.steps_per_env) * envs.size());
+  envs_.reset(mix_seed(seed, 0));
+  refresh_inference_copy();
+}
+
+int64_t OnPolicyLearner::total_iterations() const {
+  return (rollout_cfg_.total_steps + rollout_cfg_.rollout_size() - 1) / rollout_cfg_.rollout_size();
+}
+
+std::vector<OnPolicyLearner::Minibatch> OnPolicyLearner::shuffled_minibatches(int64_t size) const {
+  const int64_t N = buf_.N, first = envs_.first_index(), M = global_rows();
+  const int64_t mb = std::min<int64_t>(size, M);
+  auto perm = torch::randperm(M, torch::kLong);
+  std::vector<Minibatch> out;
+  for (int64_t start = 0; start < M; start += mb) {
+    auto idx = perm.slice(0, start, std::min(start + mb, M));
+    const double rows = double(idx.numel());
+    if (!group_.single()) {
+      // Row t * global_envs + e of the whole rollout is row t * N + (e - first) here.
+      auto t = idx.div(global_envs_, "floor"), e = idx.remainder(global_envs_) - first;
+      idx = (t * N + e).masked_select((e >= 0) & (e < N));
+    }
+    out.push_back({idx, rows});
+  }
+  return out;
+}
+
+void OnPolicyLearner::set_log_std(double log_std) {
+  torch::NoGradGuard no_grad;
+  net_->log_std.fill_(log_std);
+  refresh_inference_copy();
+}
+
+void OnPolicyLearner::net_input(const float* raw, float* out) const {
+  obs_rms_.normalize(raw, out);
+  net_->spec.features.write(raw, out + buf_.obs_dim);
+}
+
+void OnPolicyLearner::refresh_inference_copy() {
+  actor_copy_ = EigenMlp(net_->actor, net_->spec.activation);
+  log_std_ = to_floats(net_->log_std);
+}
+
+IterationStats OnPolicyLearner::iterate() {
+  IterationStats stats;
+  // Per-iteration seeds make a resumed run draw the same noise as an uninterrupted one.
+  const uint64_t noise_seed = mix_seed(seed_, 2 * iteration_ + 1);
+  for (int i = 0; i < envs_.size(); ++i) env_rng_[i].seed(mix_seed(noise_seed, uint64_t(envs_.first_index() + i)));
+  torch::manual_seed(mix_seed(seed_, 2 * iteration_ + 2));
+  auto t0 = std::chrono::steady_clock::now();
+  const double comm0 = group_.comm_seconds();
+  collect_rollout(stats);
+  auto t1 = std::chrono::steady_clock::now();
+  update(stats);
+  auto t2 = std::chrono::steady_clock::now();
+  stats.rollout_seconds = std::chrono::duration<double>(t1 - t0).count();
+  stats.update_seconds = std::chrono::duration<double>(t2 - t1).count();
+  stats.comm_seconds = group_.comm_seconds() - comm0;
+  ++iteration_;
+  global_step_ += int64_t(buf_.T) * global_envs_;
+  wall_seconds_ += stats.rollout_seconds + stats.update_seconds;
+  stats.iteration = iteration_;
+  stats.global_step = global_step_;
+  return stats;
+}
+
+void OnPolicyLearner::sample_actions(int t) {
+  const int N = buf_.N, A = buf_.act_dim;
+  float* obs = buf_.obs_at(t);
+  float* act = buf_.actions_at(t);
+  actor_copy_.forward(obs, N, mean_.data());
+  for (int i = 0; i < N; ++i) {
+    float* a = act + size_t(i) * A;
+    const float* mu = &mean_[size_t(i) * A];
+    float* eps = &noise_[size_t(i) * A];
+    if (noise_age_[i]++ % rollout_cfg_.noise_repeat == 0)
+      for (int j = 0; j < A; ++j) eps[j] = static_cast<float>(env_rng_[i].normal());
+    for (int j = 0; j < A; ++j) a[j] = mu[j] + std::exp(log_std_[j]) * eps[j];
+    buf_.log_probs[size_t(t) * N + i] = static_cast<float>(gaussian_log_prob(a, mu, log_std_.data(), A));
+  }
+}
+
+void OnPolicyLearner::collect_rollout(IterationStats& stats) {
+  const int T = buf_.T, N = buf_.N, D = buf_.obs_dim, I = buf_.in_dim;
+  buf_.truncated_index.clear();
+  buf_.truncated_obs.clear();
+  envs_.finished().clear();
+  for (int t = 0; t < T; ++t) {
+    std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf_.raw_obs_at(t));
+    for (int i = 0; i < N; ++i)
+      net_input(buf_.raw_obs_at(t) + size_t(i) * D, buf_.obs_at(t) + size_t(i) * I);
+    sample_actions(t);
+    envs_.step(buf_.actions_at(t));
+    std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf_.next_raw_obs_at(t));
+    for (int i = 0; i < N; ++i) {
+      size_t k = size_t(t) * N + i;
+      if (envs_.terminated()[i] || envs_.truncated()[i])  // obs() already holds the next episode's start
+        std::copy(envs_.final_obs() + size_t(i) * D, envs_.final_obs() + size_t(i + 1) * D,
+                  buf_.next_raw_obs_at(t) + size_t(i) * D);
+      buf_.raw_rewards[k] = envs_.reward()[i];
+      buf_.dones[k] = envs_.terminated()[i] || envs_.truncated()[i];
+      if (buf_.dones[k]) noise_age_[i] = 0;
+      if (envs_.truncated()[i] && !envs_.terminated()[i]) {
+        buf_.truncated_index.push_back(static_cast<int>(k));
+        buf_.truncated_obs.resize(buf_.truncated_obs.size() + I);
+        net_input(envs_.final_obs() + size_t(i) * D, &buf_.truncated_obs[buf_.truncated_obs.size() - I]);
+      }
+    }
+  }
+  // Episode statistics over every rank, in the task's own reward units.
+  double totals[5] = {double(envs_.finished().size()), 0, 0, 0, 0};
+  for (const auto& e : envs_.finished())
+    totals[1] += e.ret, totals[2] += e.length, totals[3] += e.success, totals[4] += e.success_count;
+  group_.sum(totals, 5);
+  stats.episodes = static_cast<int>(totals[0]);
+  if (stats.episodes > 0) {
+    stats.episode_return = totals[1] / totals[0];
+    stats.episode_length = totals[2] / totals[0];
+    stats.success_rate = totals[3] / totals[0];
+    stats.success_count = totals[4] / totals[0];
+  }
+
+  if (reward_hook_) reward_hook_(buf_);
+  // The scale of rewards: the std of the discounted return, tracked per environment and
+  // pooled over the rollout (and the ranks).
+  for (int t = 0; t < T; ++t)
+    for (int i = 0; i < N; ++i) {
+      size_t k = size_t(t) * N + i;
+      double r = buf_.raw_rewards[k];
+      buf_.rewards[k] = static_cast<float>(r);
+      running_return_[i] = running_return_[i] * rollout_cfg_.gamma + r;
+      return_samples_[k] = static_cast<float>(running_return_[i]);
+      if (buf_.dones[k]) running_return_[i] = 0.0;
+    }
+  return_rms_.update(return_samples_.data(), int64_t(T) * N, &group_);
+  if (rollout_cfg_.normalize_reward) {
+    float scale = static_cast<float>(1.0 / std::sqrt(return_rms_.var()[0] + 1e-8));
+    for (auto& r : buf_.rewards) r = std::clamp(r * scale, -10.0f, 10.0f);
+  }
+  bool finite = true;
+  for (float r : buf_.rewards) finite = finite && std::isfinite(r);
+  if (group_.any(!finite)) throw Error("task '" + envs_.spec().name + "' produced a non-finite reward");
+
+  torch::NoGradGuard no_grad;
+  auto values = net_->value(torch::from_blob(buf_.obs.data(), {int64_t(T) * N, I}));
+  std::copy(values.data_ptr<float>(), values.data_ptr<float>() + values.numel(), buf_.values.begin());
+  std::vector<float> last_obs(size_t(N) * I), last_values(N);
+  for (int i = 0; i < N; ++i) net_input(envs_.obs() + size_t(i) * D, &last_obs[size_t(i) * I]);
+  auto lv = net_->value(torch::from_blob(last_obs.data(), {N, I}));
+  std::copy(lv.data_ptr<float>(), lv.data_ptr<float>() + N, last_values.begin());
+  // A time limit is not a real end: fold gamma V(final state) into the last reward.
+  if (!buf_.truncated_index.empty()) {
+    int64_t n = static_cast<int64_t>(buf_.truncated_index.size());
+    auto tv = net_->value(torch::from_blob(buf_.truncated_obs.data(), {n, I}));
+    for (int64_t j = 0; j < n; ++j)
+      buf_.rewards[buf_.truncated_index[j]] += static_cast<float>(rollout_cfg_.gamma * tv[j].item<float>());
+  }
+  compute_gae(buf_.rewards, buf_.values, buf_.dones, last_values, T, N, rollout_cfg_.gamma, rollout_cfg_.lambda,
+              buf_.advantages, buf_.returns);
+  // The normaliser learns from this rollout only after the policy has used it.
+  obs_rms_.update(buf_.raw_obs.data(), int64_t(T) * N, &group_);
+}
+
+torch::Tensor OnPolicyLearner::log_prob(const float* raw_obs, const float* actions, int64_t n) {
+  const int D = buf_.obs_dim, I = buf_.in_dim;
+  auto obs = torch::empty({n, I});
+  for (int64_t i = 0; i < n; ++i) net_input(raw_obs + i * D, obs.data_ptr<float>() + i * I);
+  torch::NoGradGuard no_grad;
+  auto act = torch::from_blob(const_cast<float*>(actions), {n, int64_t(buf_.act_dim)});
+  return net_->log_prob(net_->mean(obs), act);
+}
+
+void OnPolicyLearner::init_actor(const Policy& p) {
+  if (p.obs_dim() > buf_.obs_dim || p.act_dim() > buf_.act_dim)
+    throw Error("init_actor: the policy's sizes differ from the trainer's");
+  // A policy without features starts a trainer with them at zero weight on the features;
+  // one with features must have the trainer's (its columns are then the same).
+  if (!p.features().empty() && (!(p.features() == net_->spec.features) || p.obs_dim() != buf_.obs_dim))
+    throw Error("init_actor: the policy's periodic input features differ from the trainer's");
+  const auto& ws = p.mlp().weights();
+  const auto& bs = p.mlp().biases();
+  torch::NoGradGuard no_grad;
+  size_t layer = 0;
+  for (auto& m : net_->actor->modules(/*include_self=*/false)) {
+    auto* linear = m->as<torch::nn::Linear>();
+    if (!linear) continue;
+    const bool first = layer == 0, last = layer + 1 == ws.size();
+    const int64_t rows = ws.size() > layer ? ws[layer].rows() : -1;
+    const int64_t cols = ws.size() > layer ? ws[layer].cols() : -1;
+    if (layer >= ws.size() || (first ? linear->weight.size(1) < cols : linear->weight.size(1) != cols) ||
+        (last ? linear->weight.size(0) < rows : linear->weight.size(0) != rows))
+      throw Error("init_actor: the policy's hidden layers differ from the trainer's");
+    if (first && linear->weight.size(1) > cols) linear->weight.zero_();
+    if (last && linear->weight.size(0) > rows) {
+      linear->weight.zero_();
+      linear->bias.zero_();
+    }
+    linear->weight.narrow(0, 0, rows).narrow(1, 0, cols).copy_(
+        torch::from_blob(const_cast<float*>(ws[layer].data()), {rows, cols}));
+    linear->bias.narrow(0, 0, rows).copy_(torch::from_blob(const_cast<float*>(bs[layer].data()), {rows}));
+    ++layer;
+  }
+  if (layer != ws.size()) throw Error("init_actor: the policy's hidden layers differ from the trainer's");
+  // Inputs the policy does not see (beyond its obs_dim) start unscaled: mean 0, var 1.
+  std::vector<double> mean(buf_.obs_dim, 0.0), var(buf_.obs_dim, 1.0);
+  for (int j = 0; j < p.obs_dim(); ++j) {
+    if (p.obs_inv_std()[j] == 0.0f) obs_rms_.ignore(j, j + 1);  // inputs the policy ignores stay ignored
+    mean[j] = p.obs_mean()[j];
+    var[j] = std::max(1.0 / (double(p.obs_inv_std()[j]) * p.obs_inv_std()[j]) - obs_rms_.eps(), 0.0);
+  }
+  // Weighted as much data as pi_b's training saw, so the first rollouts barely move it.
+  obs_rms_.set(mean, var, 1e6);
+  refresh_inference_copy();
+}
+
+void OnPolicyLearner::set_action_bias(int dim, float bias) {
+  if (dim < 0 || dim >= buf_.act_dim) throw Error("set_action_bias: no action dimension " + std::to_string(dim));
+  torch::nn::LinearImpl* last = nullptr;  // the output layer: the actor's last Linear
+  for (auto& m : net_->actor->modules(/*include_self=*/false))
+    if (auto* linear = m->as<torch::nn::Linear>()) last = linear;
+  torch::NoGradGuard no_grad;
+  last->bias[dim].fill_(bias);
+  refresh_inference_copy();
+}
+
+Policy OnPolicyLearner::policy() const {
+  const auto& spec = envs_.spec();
+  return Policy(actor_copy_, std::vector<float>(obs_rms_.mean().begin(), obs_rms_.mean().end()),
+                obs_rms_.inv_std(), static_cast<float>(obs_rms_.clip()), spec.act_low, spec.act_high,
+                net_->spec.features);
+}
+
+}  // namespace segue

@@ -1,0 +1,243 @@
+// OnPolicyLearner's checkpoint: everything an exact resume needs (networks, optimiser,
+// normalisers, counters, the episodes in flight with their action noise), one file
+// written atomically, shared by PPO and TRPO.
+#include <sstream>
+
+#include "algorithms/on_policy.h"
+#include "core/error.h"
+#include "core/run_dir.h"
+
+namespace segue {
+
+namespace {
+
+std::string key(std::string name) {
+  for (auto& c : name)
+    if (c == '.') c = '_';
+  return "ac_" + name;
+}
+torch::Tensor ints(const std::vector<int64_t>& v) { return torch::tensor(v, torch::kLong); }
+std::vector<int64_t> widen(const std::vector<int>& v) { return {v.begin(), v.end()}; }
+// The periodic features, if any (older checkpoints have none).
+void write_features(torch::serialize::OutputArchive& ar, const ObsFeatures& f) {
+  if (f.empty()) return;
+  ar.write("meta_feature_inputs", ints(widen(f.inputs)));
+  ar.write("meta_feature_periods", torch::tensor(f.periods, torch::kFloat64));
+}
+ObsFeatures read_features(torch::serialize::InputArchive& ar) {
+  ObsFeatures f;
+  torch::Tensor in, per;
+  if (!ar.try_read("meta_feature_inputs", in)) return f;
+  ar.read("meta_feature_periods", per);
+  f.inputs = to_ints(in);
+  f.periods = to_doubles(per);
+  return f;
+}
+
+}  // namespace
+
+// The environments' episodes in flight with the trainer's per-environment state (action
+// noise, its age, the discounted return), as one rank holds them or as a checkpoint does.
+struct OnPolicyLearner::InFlight {
+  std::vector<double> state, running_return;
+  std::string rngs;
+  std::vector<float> noise;
+  std::vector<int64_t> noise_age;
+
+  void append(const InFlight& o) {
+    state.insert(state.end(), o.state.begin(), o.state.end());
+    rngs += o.rngs;
+    noise.insert(noise.end(), o.noise.begin(), o.noise.end());
+    noise_age.insert(noise_age.end(), o.noise_age.begin(), o.noise_age.end());
+    running_return.insert(running_return.end(), o.running_return.begin(), o.running_return.end());
+  }
+  void write(torch::serialize::OutputArchive& ar) const {
+    ar.write("episodes_state", torch::tensor(state, torch::kFloat64));
+    ar.write("episodes_rng", text_tensor(rngs));
+    ar.write("episodes_noise", torch::tensor(noise));
+    ar.write("episodes_noise_age", torch::tensor(noise_age));
+    ar.write("episodes_running_return", torch::tensor(running_return, torch::kFloat64));
+  }
+  bool read(torch::serialize::InputArchive& ar) {
+    torch::Tensor s, r, n, a, ret;
+    if (!(ar.try_read("episodes_state", s) && ar.try_read("episodes_rng", r) && ar.try_read("episodes_noise", n) &&
+          ar.try_read("episodes_noise_age", a) && ar.try_read("episodes_running_return", ret)))
+      return false;
+    state = to_doubles(s), rngs = to_text(r), noise = to_floats(n), noise_age = to_int64s(a);
+    running_return = to_doubles(ret);
+    return true;
+  }
+  std::string bytes() const {
+    torch::serialize::OutputArchive ar;
+    write(ar);
+    std::ostringstream out;
+    ar.save_to(out);
+    return out.str();
+  }
+  static InFlight from_bytes(const std::string& b) {
+    torch::serialize::InputArchive ar;
+    std::istringstream in(b);
+    ar.load_from(in);
+    InFlight f;
+    f.read(ar);
+    return f;
+  }
+};
+
+void OnPolicyLearner::save(const std::string& path, const std::string& note, const ArchiveWriter& extra) const {
+  torch::serialize::OutputArchive ar;
+  if (extra) extra(ar);
+  for (const auto& p : net_->named_parameters()) ar.write(key(p.key()), p.value().detach());
+  torch::serialize::OutputArchive opt;
+  optimizer_->save(opt);
+  ar.write("optimizer", opt);
+  obs_rms_.save(ar, "obs_rms_");
+  return_rms_.save(ar, "return_rms_");
+  const auto& s = net_->spec;
+  ar.write("meta_counters", ints({iteration_, global_step_, int64_t(wall_seconds_ * 1000), schedule_start_}));
+  ar.write("meta_dims", ints({s.obs_dim, s.act_dim, s.activation == Activation::Tanh ? 0 : 1}));
+  ar.write("meta_pi_hidden", ints(widen(s.pi_hidden)));
+  ar.write("meta_vf_hidden", ints(widen(s.vf_hidden)));
+  write_features(ar, s.features);
+  ar.write("meta_act_low", torch::tensor(envs_.spec().act_low));
+  ar.write("meta_act_high", torch::tensor(envs_.spec().act_high));
+  ar.write("meta_note", text_tensor(note));
+  ar.write("meta_learner", text_tensor(name_));
+  // The episodes in flight, every rank's, in environment order.
+  InFlight mine;
+  const bool saved = envs_.save_episodes(mine.state, mine.rngs);
+  if (!group_.any(!saved)) {
+    mine.noise = noise_;
+    mine.noise_age.assign(noise_age_.begin(), noise_age_.end());
+    mine.running_return = running_return_;
+    InFlight all;
+    for (const std::string& part : group_.gather(group_.single() ? std::string() : mine.bytes()))
+      all.append(group_.single() ? mine : InFlight::from_bytes(part));
+    all.write(ar);
+  }
+  if (!group_.leader()) return;
+  std::ostringstream bytes;
+  ar.save_to(bytes);
+  write_file_atomic(path, bytes.str());
+}
+
+void OnPolicyLearner::load(const std::string& path, const ArchiveReader& extra, bool resume_episodes) {
+  // Rank 0 reads the file and every rank loads its bytes (other hosts need not see it).
+  const std::string kFailed = "\x01segue: unreadable\n";
+  std::string bytes;
+  if (group_.leader()) {
+    try {
+      bytes = read_file(path);
+    } catch (const Error& e) {
+      bytes = kFailed + e.what();
+    }
+  }
+  bytes = group_.broadcast(bytes);
+  if (bytes.rfind(kFailed, 0) == 0) throw Error(bytes.substr(kFailed.size()));
+  torch::serialize::InputArchive ar;
+  InFlight saved;
+  bool in_flight = false;
+  try {
+    std::istringstream in(bytes);
+    ar.load_from(in);
+    if (extra) extra(ar);
+    read_state(ar, path, resume_episodes);
+    in_flight = resume_episodes && saved.read(ar);
+  } catch (const c10::Error& e) {
+    std::string what = e.what_without_backtrace();
+    throw Error(path + ": unreadable checkpoint: " + what.substr(0, what.find('\n')));
+  }
+  refresh_inference_copy();
+  const int A = buf_.act_dim, first = envs_.first_index(), N = envs_.size();
+  if (in_flight && int64_t(saved.noise.size()) == global_envs_ * A) {
+    try {
+      std::vector<double> state;
+      std::string rngs;
+      VectorEnv::slice_episodes(saved.state, saved.rngs, first, N, state, rngs);
+      envs_.restore_episodes(state, rngs);
+      noise_.assign(saved.noise.begin() + size_t(first) * A, saved.noise.begin() + size_t(first + N) * A);
+      noise_age_.assign(saved.noise_age.begin() + first, saved.noise_age.begin() + first + N);
+      running_return_.assign(saved.running_return.begin() + first, saved.running_return.begin() + first + N);
+      return;
+    } catch (const Error& e) {
+      throw Error(path + ": " + e.what());
+    }
+  }
+  // Episodes in flight cannot be put back (or this continues another run): start fresh
+  // ones, seeded by position.
+  envs_.reset(mix_seed(seed_, 0x10000 + iteration_));
+  running_return_.assign(envs_.size(), 0.0);
+}
+
+void OnPolicyLearner::read_state(torch::serialize::InputArchive& ar, const std::string& path, bool same_run) {
+  torch::Tensor dims, learner;
+  if (!ar.try_read("meta_dims", dims))
+    throw Error(path + ": not a training checkpoint (an exported policy? a run starts from one with init_policy)");
+  // Checkpoints from before TRPO are PPO's. Another learner's optimiser state does not fit
+  // this one's: a run resumes with its own learner, a new run may continue another's
+  // networks with a fresh optimiser.
+  const std::string saved_by = ar.try_read("meta_learner", learner) ? to_text(learner) : "ppo";
+  if (same_run && saved_by != name_)
+    throw Error(path + ": the run was trained with learner '" + saved_by + "', the recipe says '" + name_ +
+                "' (a new run_dir can continue it with init_from)");
+  const int64_t obs = dims[0].item<int64_t>(), act = dims[1].item<int64_t>();
+  if (obs != net_->spec.obs_dim || act != net_->spec.act_dim)
+    throw Error(path + ": the checkpoint's policy takes obs_dim " + std::to_string(obs) + " / act_dim " +
+                std::to_string(act) + ", the task " + std::to_string(net_->spec.obs_dim) + " / " +
+                std::to_string(net_->spec.act_dim));
+  if (!(read_features(ar) == net_->spec.features))
+    throw Error(path + ": checkpoint's policy.fourier features differ from the recipe's");
+  torch::NoGradGuard no_grad;
+  for (auto& p : net_->named_parameters()) {
+    torch::Tensor t;
+    ar.read(key(p.key()), t);
+    if (t.sizes() != p.value().sizes())
+      throw Error(path + ": parameter '" + p.key() + "' has another shape than the recipe's network");
+    p.value().copy_(t);
+  }
+  if (saved_by == name_) {
+    torch::serialize::InputArchive opt;
+    ar.read("optimizer", opt);
+    optimizer_->load(opt);
+  }
+  obs_rms_.load(ar, "obs_rms_");
+  return_rms_.load(ar, "return_rms_");
+  torch::Tensor counters;
+  ar.read("meta_counters", counters);
+  iteration_ = counters[0].item<int64_t>();
+  global_step_ = counters[1].item<int64_t>();
+  wall_seconds_ = counters[2].item<int64_t>() / 1000.0;
+  schedule_start_ = counters.numel() > 3 ? counters[3].item<int64_t>() : 0;  // older checkpoints: 0
+}
+
+Policy OnPolicyLearner::policy_from_checkpoint(const std::string& path) {
+  torch::serialize::InputArchive ar;
+  ar.load_from(path);
+  torch::Tensor dims, pi, vf, low, high;
+  ar.read("meta_dims", dims);
+  ar.read("meta_pi_hidden", pi);
+  ar.read("meta_vf_hidden", vf);
+  ar.read("meta_act_low", low);
+  ar.read("meta_act_high", high);
+  ActorCriticSpec spec;
+  spec.obs_dim = static_cast<int>(dims[0].item<int64_t>());
+  spec.act_dim = static_cast<int>(dims[1].item<int64_t>());
+  spec.activation = dims[2].item<int64_t>() == 0 ? Activation::Tanh : Activation::Relu;
+  spec.pi_hidden = to_ints(pi);
+  spec.vf_hidden = to_ints(vf);
+  spec.features = read_features(ar);
+  ActorCritic net(spec);
+  torch::NoGradGuard no_grad;
+  for (auto& p : net->named_parameters()) {
+    torch::Tensor t;
+    ar.read(key(p.key()), t);
+    p.value().copy_(t);
+  }
+  RunningMeanStd rms(spec.obs_dim);
+  rms.load(ar, "obs_rms_");
+  return Policy(EigenMlp(net->actor, spec.activation),
+                std::vector<float>(rms.mean().begin(), rms.mean().end()), rms.inv_std(),
+                static_cast<float>(rms.clip()), to_floats(low), to_floats(high), spec.features);
+}
+
+}  // namespace segue

@@ -1,0 +1,75 @@
+#include "algorithms/replay_buffer.h"
+
+#include <algorithm>
+
+#include "core/error.h"
+
+namespace segue {
+
+ReplayBuffer::ReplayBuffer(int64_t capacity, int obs_dim, int act_dim)
+    : capacity_(capacity), obs_dim_(obs_dim), act_dim_(act_dim) {
+  obs_.resize(size_t(capacity) * obs_dim);
+  next_obs_.resize(size_t(capacity) * obs_dim);
+  act_.resize(size_t(capacity) * act_dim);
+  reward_.resize(capacity);
+  terminal_.resize(capacity);
+}
+
+void ReplayBuffer::add(const float* obs, const float* act, double reward, const float* next_obs, bool terminal) {
+  const size_t k = size_t(next_);
+  std::copy(obs, obs + obs_dim_, &obs_[k * obs_dim_]);
+  std::copy(next_obs, next_obs + obs_dim_, &next_obs_[k * obs_dim_]);
+  std::copy(act, act + act_dim_, &act_[k * act_dim_]);
+  reward_[k] = float(reward);
+  terminal_[k] = terminal ? 1.0f : 0.0f;
+  next_ = (next_ + 1) % capacity_;
+  size_ = std::min(size_ + 1, capacity_);
+}
+
+ReplayBuffer::Batch ReplayBuffer::gather(const std::vector<int64_t>& idx) const {
+  const int64_t b = int64_t(idx.size());
+  Batch out{torch::empty({b, obs_dim_}), torch::empty({b, act_dim_}), torch::empty({b}),
+            torch::empty({b, obs_dim_}), torch::empty({b})};
+  float *o = out.obs.data_ptr<float>(), *a = out.act.data_ptr<float>(), *r = out.reward.data_ptr<float>(),
+        *n = out.next_obs.data_ptr<float>(), *t = out.terminal.data_ptr<float>();
+  for (int64_t i = 0; i < b; ++i) {
+    const size_t k = size_t(idx[i]);
+    std::copy(&obs_[k * obs_dim_], &obs_[(k + 1) * obs_dim_], o + i * obs_dim_);
+    std::copy(&next_obs_[k * obs_dim_], &next_obs_[(k + 1) * obs_dim_], n + i * obs_dim_);
+    std::copy(&act_[k * act_dim_], &act_[(k + 1) * act_dim_], a + i * act_dim_);
+    r[i] = reward_[k], t[i] = terminal_[k];
+  }
+  return out;
+}
+
+namespace {
+torch::Tensor rows(const std::vector<float>& v, int64_t n, int64_t width) {
+  return torch::from_blob(const_cast<float*>(v.data()), {n * width}).clone();
+}
+void restore(std::vector<float>& v, const torch::Tensor& t) {
+  const auto c = t.contiguous();
+  std::copy(c.data_ptr<float>(), c.data_ptr<float>() + c.numel(), v.begin());
+}
+}  // namespace
+
+void ReplayBuffer::save(torch::serialize::OutputArchive& ar) const {
+  ar.write("replay_counters", torch::tensor({capacity_, size_, next_, int64_t(obs_dim_), int64_t(act_dim_)}));
+  ar.write("replay_obs", rows(obs_, size_, obs_dim_));
+  ar.write("replay_next_obs", rows(next_obs_, size_, obs_dim_));
+  ar.write("replay_act", rows(act_, size_, act_dim_));
+  ar.write("replay_reward", rows(reward_, size_, 1));
+  ar.write("replay_terminal", rows(terminal_, size_, 1));
+}
+
+void ReplayBuffer::load(torch::serialize::InputArchive& ar) {
+  torch::Tensor c, o, n, a, r, t;
+  ar.read("replay_counters", c);
+  if (c[0].item<int64_t>() != capacity_ || c[3].item<int64_t>() != obs_dim_ || c[4].item<int64_t>() != act_dim_)
+    throw Error("the checkpoint's replay buffer has another capacity or shape than the recipe's (sac.buffer_size)");
+  size_ = c[1].item<int64_t>(), next_ = c[2].item<int64_t>();
+  ar.read("replay_obs", o), ar.read("replay_next_obs", n), ar.read("replay_act", a);
+  ar.read("replay_reward", r), ar.read("replay_terminal", t);
+  restore(obs_, o), restore(next_obs_, n), restore(act_, a), restore(reward_, r), restore(terminal_, t);
+}
+
+}  // namespace segue

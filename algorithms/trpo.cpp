@@ -1,0 +1,147 @@
+#include "algorithms/trpo.h"
+
+#include <cmath>
+
+#include "algorithms/natural_gradient.h"
+#include "algorithms/ppo_loss.h"
+#include "core/error.h"
+
+namespace segue {
+
+TrpoConfig TrpoConfig::read(const Section& s) {
+  TrpoConfig c;
+  c.read_rollout(s);
+  c.max_kl = s.get("max_kl", c.max_kl, Range::positive());
+  c.cg_iters = s.get("cg_iters", c.cg_iters, Range::positive());
+  c.cg_damping = s.get("cg_damping", c.cg_damping, Range::non_negative());
+  c.fisher_stride = s.get("fisher_stride", c.fisher_stride, Range::positive());
+  c.line_search_steps = s.get("line_search_steps", c.line_search_steps, Range::positive());
+  c.vf_lr = s.get("vf_lr", c.vf_lr, Range::positive());
+  c.vf_epochs = s.get("vf_epochs", c.vf_epochs, Range::positive());
+  c.vf_minibatch = s.get("vf_minibatch", c.vf_minibatch, Range::positive());
+  if (c.vf_minibatch > c.rollout_size())
+    throw s.error("vf_minibatch", std::to_string(c.vf_minibatch) + " is larger than a rollout (num_envs x steps_per_env = " +
+                                      std::to_string(c.rollout_size()) + ")");
+  return c;
+}
+
+TRPO::TRPO(const TrpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed,
+           const Distributed& group)
+    : OnPolicyLearner("trpo", config, net, envs, seed, group), cfg_(config) {
+  // The optimiser fits the value network only: the policy moves by the natural step.
+  optimizer_ = std::make_unique<torch::optim::Adam>(net_->critic->parameters(), torch::optim::AdamOptions(cfg_.vf_lr));
+}
+
+void TRPO::update(IterationStats& stats) {
+  // Every rank draws the same minibatches, whatever a reward hook drew before.
+  torch::manual_seed(mix_seed(seed_, 2 * iteration_ + 2) ^ 0x9e3779b9ULL);
+  policy_step(stats);
+  fit_value(stats);
+  stats.entropy = net_->entropy().item<double>();
+  refresh_inference_copy();
+}
+
+void TRPO::policy_step(IterationStats& stats) {
+  const int64_t T = buf_.T, N = buf_.N, M = T * N;
+  const double rows = double(global_rows());  // the whole rollout's, every rank's
+  auto obs = torch::from_blob(buf_.obs.data(), {M, buf_.in_dim});
+  auto act = torch::from_blob(buf_.actions.data(), {M, buf_.act_dim});
+  auto old_logp = torch::from_blob(buf_.log_probs.data(), {M});
+  // Advantages standardised over the whole rollout.
+  auto adv64 = torch::from_blob(buf_.advantages.data(), {M}).to(torch::kFloat64);
+  double moments[2] = {adv64.sum().item<double>(), adv64.pow(2).sum().item<double>()};
+  group_.sum(moments, 2);
+  const double mean = moments[0] / rows;
+  const double std = std::sqrt(std::max(moments[1] - rows * mean * mean, 0.0) / std::max(rows - 1.0, 1.0));
+  auto adv = ((adv64 - mean) / (std + 1e-8)).to(torch::kFloat32);
+
+  std::vector<torch::Tensor> params = net_->actor->parameters();
+  params.push_back(net_->log_std);
+  // Each rank sums its rows and divides by the whole rollout's: summed over ranks, a mean.
+  auto surrogate = [&] {
+    return (torch::exp(net_->log_prob(net_->mean(obs), act) - old_logp) * adv).sum() / rows;
+  };
+  auto old_log_std = net_->log_std.detach().clone();
+  auto old_mean = net_->mean(obs).detach();
+  auto mean_kl = [&] { return gaussian_kl(old_mean, old_log_std, net_->mean(obs), net_->log_std).sum() / rows; };
+  // The Fisher-vector product's rows: every fisher_stride-th row of the whole rollout
+  // (row t * envs + e over every rank), so any rank layout uses the same ones.
+  const int64_t envs = global_rows() / T, first = envs_.first_index(), stride = cfg_.fisher_stride;
+  std::vector<int64_t> fisher_rows;
+  for (int64_t t = 0; t < T; ++t)
+    for (int64_t i = 0; i < N; ++i)
+      if ((t * envs + first + i) % stride == 0) fisher_rows.push_back(t * N + i);
+  const double fisher_count = double((global_rows() + stride - 1) / stride);
+  auto fisher_idx = torch::tensor(fisher_rows, torch::kLong);
+  auto fisher_obs = obs.index_select(0, fisher_idx), fisher_old_mean = old_mean.index_select(0, fisher_idx);
+  auto fisher_kl = [&] {
+    return gaussian_kl(fisher_old_mean, old_log_std, net_->mean(fisher_obs), net_->log_std).sum() / fisher_count;
+  };
+
+  auto s0 = surrogate();
+  auto g = flatten(torch::autograd::grad({s0}, params));
+  group_.sum(g);
+  double surrogate_old = s0.item<double>();
+  group_.sum(&surrogate_old, 1);
+  if (!std::isfinite(surrogate_old) || !torch::isfinite(g).all().item<bool>())
+    throw Error("TRPO's surrogate became non-finite at iteration " + std::to_string(iteration_ + 1) + " (task '" +
+                envs_.spec().name + "'); the last checkpoint is kept: check the task's rewards");
+  stats.policy_loss = -surrogate_old, stats.approx_kl = 0, stats.step_size = 0;
+  if (g.abs().max().item<double>() == 0.0) return;  // all advantages zero: nothing to improve
+
+  // F v + damping v, F summed over ranks (each rank's rows weighted by the whole count).
+  auto fisher_vector = [&](const torch::Tensor& v) {
+    auto fv = hessian_vector_product(fisher_kl, params, v);
+    group_.sum(fv);
+    return fv + cfg_.cg_damping * v;
+  };
+  auto x = conjugate_gradient(fisher_vector, g, cfg_.cg_iters);
+  // The step to the trust region's edge under the quadratic model: 0.5 s'Fs = max_kl.
+  const double shs = 0.5 * x.dot(fisher_vector(x)).item<double>();
+  if (!(shs > 0.0) || !std::isfinite(shs)) return;
+  auto full_step = x * std::sqrt(cfg_.max_kl / shs);
+  auto theta_old = flatten(params).detach().clone();
+  torch::NoGradGuard no_grad;
+  for (int k = 0; k < cfg_.line_search_steps; ++k) {
+    const double fraction = std::pow(0.5, k);
+    assign_flat(params, theta_old + fraction * full_step);
+    double now[2] = {surrogate().item<double>(), mean_kl().item<double>()};
+    group_.sum(now, 2);
+    if (std::isfinite(now[0]) && std::isfinite(now[1]) && now[1] <= 1.5 * cfg_.max_kl && now[0] > surrogate_old) {
+      stats.policy_loss = -now[0], stats.approx_kl = now[1], stats.step_size = fraction;
+      if (rollout_cfg_.min_log_std > -20.0) net_->log_std.clamp_min_(rollout_cfg_.min_log_std);
+      return;
+    }
+  }
+  assign_flat(params, theta_old);  // no step kept the surrogate improving inside the region
+}
+
+void TRPO::fit_value(IterationStats& stats) {
+  const int64_t M = int64_t(buf_.T) * buf_.N;
+  auto obs = torch::from_blob(buf_.obs.data(), {M, buf_.in_dim});
+  auto ret = torch::from_blob(buf_.returns.data(), {M});
+  const std::vector<torch::Tensor> params = net_->critic->parameters();
+  double total = 0.0;
+  int batches = 0;
+  for (int epoch = 0; epoch < cfg_.vf_epochs; ++epoch)
+    for (const Minibatch& m : shuffled_minibatches(cfg_.vf_minibatch)) {
+      optimizer_->zero_grad();
+      const double share = double(m.rows.numel()) / m.global_rows;  // this rank's part of the minibatch
+      double local = 0.0;
+      if (m.rows.numel() > 0) {
+        auto loss = value_loss(net_->value(obs.index_select(0, m.rows)), ret.index_select(0, m.rows)) * share;
+        loss.backward();
+        local = loss.item<double>();
+      }
+      const double sum = group_.sum_gradients(params, local);
+      if (!std::isfinite(sum))
+        throw Error("TRPO's value loss became " + std::to_string(sum) + " at iteration " +
+                    std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
+                    "'); the last checkpoint is kept: lower trpo.vf_lr or check the task's rewards");
+      optimizer_->step();
+      total += sum, ++batches;
+    }
+  stats.value_loss = total / batches;
+}
+
+}  // namespace segue

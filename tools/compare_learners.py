@@ -1,0 +1,153 @@
+#!/usr/bin/env python3
+"""The learners side by side: each skill trained by each learner on several seeds at the
+same environment-step budget, then one table and one figure.
+
+  python3 tools/compare_learners.py [--skills walker_forward] [--learners ppo,trpo]
+                                    [--seeds 1,2,3] [--threads 1] [--runs runs/learners]
+                                    [--steps N] [--report-only] [--out docs/learner_comparison]
+
+A learner's recipe for a skill: `ppo` is the shipped one, experiments/primitives/SKILL.yaml;
+any other is experiments/learners/SKILL_LEARNER.yaml. Every run is `segue train RECIPE
+--set seed=S --set run_dir=RUNS/SKILL/LEARNER/seedS` (resumable: rerunning the command
+resumes unfinished runs and skips finished ones); `--steps` sets every run's budget.
+Writes OUT.md (the table: final deterministic success from each run's eval.json, mean and
+spread over seeds; environment steps and wall time until the training episodes first
+succeed 90% of the time) and OUT.png (training success against environment steps, mean
+and min-max over seeds). Bad input prints one line to stderr and exits 2.
+"""
+import argparse
+import csv
+import json
+import math
+import os
+import subprocess
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+THRESHOLD = 0.9
+
+
+class InputError(Exception):
+    pass
+
+
+def recipe(skill, learner):
+    rel = (f"experiments/primitives/{skill}.yaml" if learner == "ppo"
+           else f"experiments/learners/{skill}_{learner}.yaml")
+    if not os.path.exists(os.path.join(ROOT, rel)):
+        raise InputError(f"no recipe for {skill} with {learner}: {rel} does not exist")
+    return rel
+
+
+def train(skill, learner, seed, args):
+    run_dir = os.path.join(args.runs, skill, learner, f"seed{seed}")
+    if os.path.exists(os.path.join(run_dir, "eval.json")):
+        return run_dir
+    cmd = [os.path.join(ROOT, "build", "segue"), "train", recipe(skill, learner), "--set", f"seed={seed}",
+           "--set", f"run_dir={run_dir}", "--threads", str(args.threads)]
+    if args.steps:
+        cmd += ["--set", f"{learner}.total_steps={args.steps}"]
+    print(" ".join(cmd), flush=True)
+    if subprocess.call(cmd, cwd=ROOT) != 0:
+        raise InputError(f"training failed: {' '.join(cmd)}")
+    return run_dir
+
+
+def read_run(run_dir):
+    path = os.path.join(run_dir, "metrics.csv")
+    try:
+        with open(path, newline="") as f:
+            rows = list(csv.DictReader(f))
+        with open(os.path.join(run_dir, "eval.json")) as f:
+            final = json.load(f)
+    except OSError as e:
+        raise InputError(f"{e.filename}: cannot read ({e.strerror}); run without --report-only first")
+    steps = [float(r["global_step"]) for r in rows]
+    success = [float(r["success_rate"]) if r["success_rate"] not in ("", "nan") else math.nan for r in rows]
+    wall = [float(r["wall_seconds"]) for r in rows]
+    reached = next((i for i, s in enumerate(success) if s >= THRESHOLD), None)
+    return {"steps": steps, "success": success, "final": final["success_rate"], "env_steps": final["env_steps"],
+            "to_threshold": None if reached is None else (steps[reached], wall[reached])}
+
+
+def fmt_steps(x):
+    return f"{x / 1e6:.1f}M"
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--skills", default="walker_forward")
+    p.add_argument("--learners", default="ppo,trpo")
+    p.add_argument("--seeds", default="1,2,3")
+    p.add_argument("--threads", type=int, default=1)
+    p.add_argument("--runs", default="runs/learners")
+    p.add_argument("--steps", type=int, default=0, help="every run's environment-step budget (default: the recipes')")
+    p.add_argument("--report-only", action="store_true", help="read finished runs, train nothing")
+    p.add_argument("--out", default="docs/learner_comparison")
+    args = p.parse_args()
+    skills, learners = args.skills.split(","), args.learners.split(",")
+    try:
+        seeds = [int(s) for s in args.seeds.split(",")]
+    except ValueError:
+        raise InputError(f"--seeds: expected integers, got '{args.seeds}'")
+    runs = {}
+    for skill in skills:
+        for learner in learners:
+            for seed in seeds:
+                run_dir = os.path.join(args.runs, skill, learner, f"seed{seed}")
+                if not args.report_only:
+                    train(skill, learner, seed, args)
+                runs[skill, learner, seed] = read_run(run_dir)
+
+    lines = [f"Deterministic success of the final policy (each run's evaluation, 50 episodes), mean and",
+             f"range over seeds {args.seeds}; environment steps and wall time until the training episodes",
+             f"first succeed {THRESHOLD:.0%} of the time (median over the seeds that get there).", "",
+             "| skill | learner | env steps | final success | seeds at 90% | steps to 90% | wall time to 90% |",
+             "|---|---|---|---|---|---|---|"]
+    fig, axes = plt.subplots(1, len(skills), figsize=(6 * len(skills), 4), squeeze=False)
+    for k, skill in enumerate(skills):
+        ax = axes[0][k]
+        for learner in learners:
+            rs = [runs[skill, learner, s] for s in seeds]
+            finals = [r["final"] for r in rs]
+            reached = sorted(r["to_threshold"] for r in rs if r["to_threshold"])
+            mid = reached[len(reached) // 2] if reached else None
+            lines.append(f"| {skill} | {learner} | {fmt_steps(rs[0]['env_steps'])} | "
+                         f"{sum(finals) / len(finals):.0%} ({min(finals):.0%}-{max(finals):.0%}) | "
+                         f"{len(reached)}/{len(rs)} | {fmt_steps(mid[0]) if mid else '-'} | "
+                         f"{f'{mid[1] / 60:.0f} min' if mid else '-'} |")
+            n = min(len(r["steps"]) for r in rs)
+            x = [s / 1e6 for s in rs[0]["steps"][:n]]
+            ys = [[r["success"][i] for r in rs] for i in range(n)]
+            mean = [sum(v) / len(v) for v in ys]
+            ax.plot(x, mean, label=f"{learner} (mean of {len(rs)} seeds)")
+            ax.fill_between(x, [min(v) for v in ys], [max(v) for v in ys], alpha=0.25)
+        ax.set_title(skill)
+        ax.set_xlabel("environment steps (millions)")
+        ax.set_ylabel("training success rate")
+        ax.set_ylim(-0.02, 1.02)
+        ax.grid(alpha=0.3)
+        ax.legend(loc="lower right")
+    fig.tight_layout()
+    cmd = "python3 tools/compare_learners.py " + " ".join(
+        f"--{k.replace('_', '-')} {v}" for k, v in vars(args).items()
+        if k not in ("report_only", "out", "threads") and v not in (0, None))
+    lines += ["", f"Produced by `{cmd}`; the band is the range over seeds.", ""]
+    os.makedirs(os.path.dirname(os.path.abspath(args.out)), exist_ok=True)
+    fig.savefig(args.out + ".png", dpi=110)
+    with open(args.out + ".md", "w") as f:
+        f.write("\n".join(lines))
+    print("\n".join(lines))
+
+
+if __name__ == "__main__":
+    try:
+        main()
+    except InputError as e:
+        print(f"error: {e}", file=sys.stderr)
+        sys.exit(2)
