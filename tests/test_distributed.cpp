@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "core/distributed.h"
+#include "core/run_dir.h"
 #include "hrl/collection.h"
 #include "tests/cli_run.h"
 #include "tests/csv.h"
@@ -113,6 +114,46 @@ class DataParallel : public TempDirTest {
     return segue_ok("train " + file + " " + flags);
   }
 };
+
+// TRPO on two ranks: the gradient, each Fisher-vector product, the line search's
+// surrogate and KL and the value network's minibatch gradients are summed over ranks, so
+// the two ranks take the step one process takes.
+// After one iteration the checkpoints agree to float tolerance; over three, the rounding
+// that conjugate gradient amplifies moves the walker's chaotic episodes apart a little,
+// so the metrics are compared to 1e-3.
+TEST_F(DataParallel, TwoRanksTakeTheTrpoStepOneProcessTakes) {
+  for (int iterations : {1, 3}) {
+    auto trpo = [&](const std::string& name) {
+      const std::string file = path(name + ".yaml");
+      std::ofstream(file) << "task: walker_forward\nthreads: 1\nrun_dir: " << path(name)
+                          << "\ncheckpoint_every: 1\nlearner: trpo\n"
+                             "env: {max_episode_steps: 50, success_steps: 50}\n"
+                             "trpo: {total_steps: " << 256 * iterations
+                          << ", num_envs: 4, steps_per_env: 64, vf_minibatch: 128, vf_epochs: 2}\n"
+                             "eval: {episodes: 1}\n";
+      return file;
+    };
+    const std::string one = "trpo_one" + std::to_string(iterations), two = "trpo_two" + std::to_string(iterations);
+    train(trpo(one));
+    const std::string out = train(trpo(two), "--nproc 2");
+    EXPECT_NE(out.find("on 2 ranks"), std::string::npos) << out;
+    if (iterations == 1) {
+      torch::serialize::InputArchive a, b;
+      a.load_from(path(one) + "/checkpoint.pt");
+      b.load_from(path(two) + "/checkpoint.pt");
+      EXPECT_GT(expect_close_archives(a, b, "checkpoint.pt: ", 2e-5), 20);
+    }
+    auto m1 = csv(path(one) + "/metrics.csv"), m2 = csv(path(two) + "/metrics.csv");
+    ASSERT_EQ(m1.size(), size_t(iterations + 1));
+    ASSERT_EQ(m1.size(), m2.size());
+    const double tol = iterations == 1 ? 1e-5 : 1e-3;
+    for (size_t r = 1; r < m1.size(); ++r)
+      for (size_t c = 0; c < m1[0].size(); ++c)
+        if (!timing(m1[0][c]))
+          EXPECT_NEAR(std::stod(m1[r][c]), std::stod(m2[r][c]), tol * (1 + std::abs(std::stod(m1[r][c]))))
+              << iterations << " iterations, row " << r << " column " << m1[0][c];
+  }
+}
 
 TEST_F(DataParallel, TwoRanksTrainWhatOneProcessTrains) {
   // One iteration of one minibatch: Adam's first moments are 0.1 x the (clipped) gradient,
@@ -289,6 +330,103 @@ TEST_F(DataParallel, AHungRankStopsTheOthersWithinTheTimeout) {
   EXPECT_NE(text.find("error: rank 0: lost the other ranks in"), std::string::npos) << text;
   EXPECT_NE(text.find("SEGUE_DIST_TIMEOUT=2 s"), std::string::npos) << text;
   EXPECT_NE(text.find("the other ranks were stopped"), std::string::npos) << text;
+}
+
+}  // namespace
+}  // namespace segue
+
+namespace segue {
+namespace {
+
+// Two "hosts": network namespaces joined by a veth pair, each with its own address, rank 0
+// serving the store on host A's. Needs root and `ip netns`; where the machine refuses,
+// the tests say so and skip (the local-rank tests above still run).
+class TwoHosts : public DataParallel {
+ protected:
+  void SetUp() override {
+    DataParallel::SetUp();
+    const std::string id = std::to_string(::getpid() % 100000);
+    ns_a_ = "segue_a" + id, ns_b_ = "segue_b" + id, veth_a_ = "sga" + id, veth_b_ = "sgb" + id;
+    const std::string setup = "ip netns add " + ns_a_ + " && ip netns add " + ns_b_ + " && ip link add " + veth_a_ +
+                              " type veth peer name " + veth_b_ + " && ip link set " + veth_a_ + " netns " + ns_a_ +
+                              " && ip link set " + veth_b_ + " netns " + ns_b_ + " && ip -n " + ns_a_ +
+                              " addr add 10.231.7.1/24 dev " + veth_a_ + " && ip -n " + ns_b_ +
+                              " addr add 10.231.7.2/24 dev " + veth_b_ + " && ip -n " + ns_a_ + " link set " +
+                              veth_a_ + " up && ip -n " + ns_b_ + " link set " + veth_b_ + " up && ip -n " + ns_a_ +
+                              " link set lo up && ip -n " + ns_b_ + " link set lo up";
+    ready_ = std::system((setup + " >/dev/null 2>&1").c_str()) == 0;
+    if (!ready_) GTEST_SKIP() << "this machine does not allow network namespaces (ip netns add: needs root)";
+  }
+  void TearDown() override {
+    std::system(("ip netns del " + ns_a_ + " >/dev/null 2>&1; ip netns del " + ns_b_ + " >/dev/null 2>&1").c_str());
+    DataParallel::TearDown();
+  }
+  // Rank `rank` of 2 on its host, `segue train FILE`, all it prints into `log`.
+  pid_t start_rank(int rank, const std::string& file, const std::string& log) {
+    const pid_t pid = fork();
+    if (pid == 0) {
+      freopen(log.c_str(), "w", stdout);
+      dup2(fileno(stdout), fileno(stderr));
+      const std::string ns = rank == 0 ? ns_a_ : ns_b_, ifname = rank == 0 ? veth_a_ : veth_b_;
+      const std::string r = "RANK=" + std::to_string(rank), gloo = "GLOO_SOCKET_IFNAME=" + ifname;
+      // `ip netns exec` runs the command in the same process: the pid is segue's.
+      execlp("ip", "ip", "netns", "exec", ns.c_str(), "env", r.c_str(), "WORLD_SIZE=2", "MASTER_ADDR=10.231.7.1",
+             "MASTER_PORT=29531", gloo.c_str(), "SEGUE_DIST_TIMEOUT=10", SEGUE_BINARY, "train", file.c_str(),
+             static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    return pid;
+  }
+  int wait_exit(pid_t pid) {
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  }
+  void expect_same_metrics(const std::string& a, const std::string& b, double tol) {
+    auto m1 = csv(a), m2 = csv(b);
+    ASSERT_EQ(m1.size(), m2.size());
+    for (size_t r = 1; r < m1.size(); ++r)
+      for (size_t c = 0; c < m1[0].size(); ++c)
+        if (!timing(m1[0][c]))
+          EXPECT_NEAR(std::stod(m1[r][c]), std::stod(m2[r][c]), tol * (1 + std::abs(std::stod(m1[r][c]))))
+              << "row " << r << " column " << m1[0][c];
+  }
+  bool ready_ = false;
+  std::string ns_a_, ns_b_, veth_a_, veth_b_;
+};
+
+TEST_F(TwoHosts, TrainWhatOneProcessTrains) {
+  train(recipe("one", 3));
+  const std::string file = recipe("hosts", 3);
+  const pid_t a = start_rank(0, file, path("a.log")), b = start_rank(1, file, path("b.log"));
+  EXPECT_EQ(wait_exit(a), 0) << read_file(path("a.log"));
+  EXPECT_EQ(wait_exit(b), 0) << read_file(path("b.log"));
+  torch::serialize::InputArchive x, y;
+  x.load_from(path("one") + "/checkpoint.pt");
+  y.load_from(path("hosts") + "/checkpoint.pt");
+  EXPECT_GT(expect_close_archives(x, y, "checkpoint.pt: ", 2e-5), 40);
+  expect_same_metrics(path("one") + "/metrics.csv", path("hosts") + "/metrics.csv", 1e-5);
+}
+
+TEST_F(TwoHosts, AKilledHostStopsTheOtherInOneLineAndTheRerunResumes) {
+  train(recipe("one", 6));
+  const std::string file = recipe("killed", 6);
+  const pid_t a = start_rank(0, file, path("a.log")), b = start_rank(1, file, path("b.log"));
+  int status = 0;
+  ASSERT_TRUE(wait_until(a, [&] { return csv(path("killed") + "/metrics.csv").size() >= 3; }, &status))
+      << "rank 0 ended before its second iteration: " << read_file(path("a.log"));
+  ::kill(b, SIGKILL);
+  wait_exit(b);
+  EXPECT_NE(wait_exit(a), 0);
+  const std::string log = read_file(path("a.log"));
+  EXPECT_NE(log.find("error: "), std::string::npos) << log;
+  EXPECT_NE(log.find("lost the other ranks"), std::string::npos) << log;
+  // Both hosts rerun the same command: the run resumes from its last checkpoint.
+  const pid_t a2 = start_rank(0, file, path("a2.log")), b2 = start_rank(1, file, path("b2.log"));
+  EXPECT_EQ(wait_exit(a2), 0) << read_file(path("a2.log"));
+  EXPECT_EQ(wait_exit(b2), 0) << read_file(path("b2.log"));
+  EXPECT_NE(read_file(path("a2.log")).find("resuming"), std::string::npos) << read_file(path("a2.log"));
+  expect_same_metrics(path("one") + "/metrics.csv", path("killed") + "/metrics.csv", 1e-4);
 }
 
 }  // namespace

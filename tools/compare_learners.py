@@ -17,6 +17,7 @@ and min-max over seeds). Bad input prints one line to stderr and exits 2.
 """
 import argparse
 import csv
+import fcntl
 import json
 import math
 import os
@@ -46,6 +47,11 @@ def recipe(skill, learner):
 
 def train(skill, learner, seed, args):
     run_dir = os.path.join(args.runs, skill, learner, f"seed{seed}")
+    # Several copies of this command may share the runs (e.g. one per core, seeds in
+    # another order): a run is trained by whichever takes its lock first.
+    os.makedirs(os.path.dirname(run_dir), exist_ok=True)
+    lock = open(run_dir + ".lock", "w")
+    fcntl.flock(lock, fcntl.LOCK_EX)
     if os.path.exists(os.path.join(run_dir, "eval.json")):
         return run_dir
     cmd = [os.path.join(ROOT, "build", "segue"), "train", recipe(skill, learner), "--set", f"seed={seed}",
@@ -60,6 +66,8 @@ def train(skill, learner, seed, args):
 
 def read_run(run_dir):
     path = os.path.join(run_dir, "metrics.csv")
+    if not os.path.exists(os.path.join(run_dir, "eval.json")):
+        return None  # not finished
     try:
         with open(path, newline="") as f:
             rows = list(csv.DictReader(f))
@@ -102,22 +110,29 @@ def main():
                 run_dir = os.path.join(args.runs, skill, learner, f"seed{seed}")
                 if not args.report_only:
                     train(skill, learner, seed, args)
-                runs[skill, learner, seed] = read_run(run_dir)
+                run = read_run(run_dir)
+                if run:
+                    runs[skill, learner, seed] = run
+    if not runs:
+        raise InputError(f"no finished run under {args.runs}; run without --report-only first")
 
     lines = [f"Deterministic success of the final policy (each run's evaluation, 50 episodes), mean and",
-             f"range over seeds {args.seeds}; environment steps and wall time until the training episodes",
+             f"range over the seeds (runs not yet finished are left out); environment steps and wall time until the training episodes",
              f"first succeed {THRESHOLD:.0%} of the time (median over the seeds that get there).", "",
-             "| skill | learner | env steps | final success | seeds at 90% | steps to 90% | wall time to 90% |",
-             "|---|---|---|---|---|---|---|"]
+             "| skill | learner | seeds | env steps | final success | seeds at 90% | steps to 90% | wall time to 90% |",
+             "|---|---|---|---|---|---|---|---|"]
     fig, axes = plt.subplots(1, len(skills), figsize=(6 * len(skills), 4), squeeze=False)
     for k, skill in enumerate(skills):
         ax = axes[0][k]
         for learner in learners:
-            rs = [runs[skill, learner, s] for s in seeds]
+            done = [s for s in seeds if (skill, learner, s) in runs]
+            if not done:
+                continue
+            rs = [runs[skill, learner, s] for s in done]
             finals = [r["final"] for r in rs]
             reached = sorted(r["to_threshold"] for r in rs if r["to_threshold"])
             mid = reached[len(reached) // 2] if reached else None
-            lines.append(f"| {skill} | {learner} | {fmt_steps(rs[0]['env_steps'])} | "
+            lines.append(f"| {skill} | {learner} | {','.join(map(str, done))} | {fmt_steps(rs[0]['env_steps'])} | "
                          f"{sum(finals) / len(finals):.0%} ({min(finals):.0%}-{max(finals):.0%}) | "
                          f"{len(reached)}/{len(rs)} | {fmt_steps(mid[0]) if mid else '-'} | "
                          f"{f'{mid[1] / 60:.0f} min' if mid else '-'} |")

@@ -9,6 +9,7 @@ PACKAGES=(
   libopenblas0-openmp     # a fast BLAS for LibTorch (else the reference BLAS is used)
   libeigen3-dev libyaml-cpp-dev libspdlog-dev libgtest-dev
   libgloo-dev             # the headers c10d's ProcessGroupGloo includes (segue --nproc)
+  iproute2                # ip netns: the two-host data-parallel tests
   clang libclang-rt-14-dev   # the recipe fuzzer (libFuzzer, ASan, UBSan; tests/fuzz)
   python3-torch           # to check exported TorchScript from Python
   python3-matplotlib python3-sklearn   # segue plot, report charts, tools/tsne_actions.py

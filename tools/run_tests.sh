@@ -26,10 +26,10 @@ fi
 rm -rf "$corpus"
 # The suite under AddressSanitizer and UndefinedBehaviorSanitizer (build-asan/), less the
 # tests that measure learning or time kills (slow there, and no other code paths):
-# Jaco.PpoImprovesThePickReturn, PpoLearning.*, EvolutionStrategy.Improves*, KillSoak.*,
+# Jaco.PpoImprovesThePickReturn, PpoLearning.*, Trpo.Improves*, Sac.Improves*, EvolutionStrategy.Improves*, KillSoak.*,
 # and the Python tools. LeakSanitizer is off: LibTorch and MuJoCo keep process-lifetime
 # allocations.
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=Release -DSEGUE_SANITIZE=ON >/dev/null
 cmake --build build-asan -j "$(nproc)"
 (cd build-asan && ASAN_OPTIONS=detect_leaks=0 ctest --output-on-failure -j 2 --timeout 900 \
-  -E '^(Jaco\.PpoImprovesThePickReturn|PpoLearning\..*|EvolutionStrategy\.Improves.*|KillSoak\..*|TsneTool|PlotTool)$')
+  -E '^(Jaco\.PpoImprovesThePickReturn|PpoLearning\..*|Trpo\.Improves.*|Sac\.Improves.*|EvolutionStrategy\.Improves.*|KillSoak\..*|TsneTool|PlotTool)$')
