@@ -33,21 +33,6 @@ std::vector<std::string> split_key(const std::string& key) {
   return parts;
 }
 
-// Edit distance, to suggest the key a typo meant.
-size_t distance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diag = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] != b[j - 1])});
-      diag = up;
-    }
-  }
-  return row[b.size()];
-}
 
 void set_path(YAML::Node root, const std::vector<std::string>& parts, const YAML::Node& value) {
   // yaml-cpp nodes are handles: walk down by reassigning a handle copy.
@@ -353,7 +338,7 @@ void Recipe::reject_unknown() const {
     std::string best;
     size_t best_d = 4;
     for (const auto& known : s_->read) {
-      size_t d = distance(leaf, known);
+      size_t d = edit_distance(leaf, known);
       if (d < best_d) best_d = d, best = known;
     }
     std::string origin = s_->overridden.count(leaf) ? " (from --set)" : "";
@@ -372,6 +357,21 @@ std::string Recipe::resolved_yaml() const {
   e.SetFloatPrecision(7);
   e << s_->resolved;
   return std::string(e.c_str()) + "\n";
+}
+
+size_t edit_distance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diag = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] != b[j - 1])});
+      diag = up;
+    }
+  }
+  return row[b.size()];
 }
 
 }  // namespace segue

@@ -234,4 +234,7 @@ T Section::convert(const YAML::Node& node, const std::string& k) const {
   }
 }
 
+// Levenshtein distance: how a typo is matched to the name it meant ("did you mean").
+size_t edit_distance(const std::string& a, const std::string& b);
+
 }  // namespace segue

@@ -3,7 +3,10 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <cctype>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <sstream>
@@ -16,22 +19,45 @@ namespace fs = std::filesystem;
 
 namespace segue {
 
+namespace {
+// Why a file could not be written, from errno: "the folder 'x' does not exist",
+// "permission denied", ...
+std::string write_failure(const std::string& path, int error) {
+  const fs::path folder = fs::path(path).parent_path();
+  std::error_code ec;
+  if (error == ENOENT && !folder.empty() && !fs::exists(folder, ec))
+    return "the folder '" + folder.string() + "' does not exist";
+  if (error == ENOTDIR && !folder.empty() && fs::exists(folder, ec) && !fs::is_directory(folder, ec))
+    return "'" + folder.string() + "' is not a folder";
+  std::string why = std::strerror(error);
+  if (!why.empty()) why[0] = char(std::tolower(static_cast<unsigned char>(why[0])));
+  return why;
+}
+}  // namespace
+
 void write_file_atomic(const std::string& path, const std::string& bytes) {
   std::string tmp = path + ".tmp";
   int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  if (fd < 0) throw Error(path + ": cannot write");
+  if (fd < 0) {
+    const int e = errno;
+    throw Error(path + ": cannot write: " + write_failure(path, e));
+  }
   size_t done = 0;
   while (done < bytes.size()) {
     ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
     if (n <= 0) {
+      const int e = n < 0 ? errno : ENOSPC;
       ::close(fd);
-      throw Error(path + ": write failed (disk full?)");
+      throw Error(path + ": write failed: " + write_failure(path, e));
     }
     done += size_t(n);
   }
   ::fsync(fd);
   ::close(fd);
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) throw Error(path + ": cannot replace file");
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    const int e = errno;
+    throw Error(path + ": cannot replace file: " + write_failure(path, e));
+  }
 }
 
 std::string read_file(const std::string& path) {

@@ -6,8 +6,10 @@
 #include "environments/jaco_skills.h"
 #include "environments/jaco_tasks.h"
 #include "environments/walker.h"
+#include "environments/walker_balance.h"
 #include "environments/walker_course.h"
 #include "environments/walker_obstacles.h"
+#include "environments/walker_patrol.h"
 
 namespace segue {
 namespace {

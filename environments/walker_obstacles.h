@@ -3,7 +3,8 @@
 // carries five of each, parked behind the start; a task lays out the ones it uses at
 // reset. Obstacle observations follow the reference: (start - x, end - x) of the next
 // obstacle, x the smallest x of torso and feet, or fixed "far" values when the next
-// obstacle is beyond the detection distance.
+// obstacle is beyond the detection distance. Here: that base (WalkerObstacleEnv) and the
+// jump and crawl sub-tasks; the courses of several obstacles are walker_course.h.
 #include <array>
 #include <vector>
 
@@ -218,15 +219,6 @@ class WalkerCrawl : public WalkerObstacleEnv {
 
  private:
   Config ccfg_;
-};
-
-// Balance: stand still under strong pushes for success_steps steps.
-class WalkerBalance : public WalkerEnv {
- public:
-  using WalkerEnv::WalkerEnv;
-
- protected:
-  StepResult evaluate(const float* action) override;
 };
 
 }  // namespace segue

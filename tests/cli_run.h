@@ -1,7 +1,10 @@
 #pragma once
 // Runs the segue binary with `args` and returns its exit code and everything it printed
 // (stdout and stderr together).
+#include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <chrono>
@@ -41,6 +44,37 @@ inline bool wait_until(pid_t pid, const std::function<bool()>& reached, int* sta
     }
     std::this_thread::sleep_for(std::chrono::milliseconds(1));  // a poll, not a deadline
   }
+  return true;
+}
+
+// `segue train FILE` in the background, all it prints discarded; returns its pid.
+inline pid_t start_train(const std::string& file) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    freopen("/dev/null", "w", stdout);
+    freopen("/dev/null", "w", stderr);
+    execl(SEGUE_BINARY, SEGUE_BINARY, "train", file.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  return pid;
+}
+
+// The inode of `file`, 0 if there is none: write_file_atomic renames a new file in, so a
+// checkpoint's inode changes with every checkpoint written.
+inline ino_t inode(const std::string& file) {
+  struct stat st {};
+  return ::stat(file.c_str(), &st) == 0 ? st.st_ino : 0;
+}
+
+// Starts `segue train FILE` and kills it (SIGKILL) once it has written a checkpoint after
+// the one at `checkpoint` now, i.e. in the rollout after it. False if the run ended first.
+inline bool kill_after_next_checkpoint(const std::string& file, const std::string& checkpoint) {
+  const ino_t before = inode(checkpoint);
+  const pid_t pid = start_train(file);
+  if (!wait_until(pid, [&] { return inode(checkpoint) != before && inode(checkpoint) != 0; })) return false;
+  ::kill(pid, SIGKILL);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
   return true;
 }
 

@@ -8,6 +8,7 @@
 
 #include "tests/task_fixture.h"
 #include "environments/walker_course.h"
+#include "environments/walker_patrol.h"
 #include "hrl/meta_controller.h"
 
 namespace segue {

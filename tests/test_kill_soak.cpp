@@ -5,11 +5,6 @@
 // directory, never on the clock, so all twenty land on a machine of any speed.
 #include <gtest/gtest.h>
 
-#include <signal.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <fstream>
 #include <sstream>
 
@@ -63,13 +58,6 @@ size_t row_count(const std::string& file) {
   return n > 0 ? n - 1 : 0;
 }
 
-// The checkpoint's inode: write_file_atomic renames a new file in, so it changes with
-// every checkpoint written (0 while there is none).
-ino_t inode(const std::string& file) {
-  struct stat st {};
-  return ::stat(file.c_str(), &st) == 0 ? st.st_ino : 0;
-}
-
 TEST_F(KillSoak, TwentyKillsAtRandomPointsOfProgressResumeToABitIdenticalPolicy) {
   const std::string unbroken = recipe("unbroken"), killed = recipe("killed");
   ASSERT_EQ(run_cli("train " + unbroken).code, 0);
@@ -81,13 +69,7 @@ TEST_F(KillSoak, TwentyKillsAtRandomPointsOfProgressResumeToABitIdenticalPolicy)
     const size_t rows_before = row_count(metrics);
     const ino_t checkpoint_before = inode(checkpoint);
     const int moment = rng.integer(0, 3), ahead = rng.integer(1, 2);
-    const pid_t pid = fork();
-    if (pid == 0) {
-      freopen("/dev/null", "w", stdout);
-      freopen("/dev/null", "w", stderr);
-      execl(SEGUE_BINARY, SEGUE_BINARY, "train", killed.c_str(), static_cast<char*>(nullptr));
-      _exit(127);
-    }
+    const pid_t pid = start_train(killed);
     const size_t target = rows_before + ahead;
     std::function<bool()> reached = [] { return true; };  // 0: at start-up, before any checkpoint of this life
     if (moment == 1)  // just after a metrics row, before (or while) its checkpoint is written

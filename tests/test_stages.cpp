@@ -24,17 +24,6 @@ namespace {
 int run_segue(const std::string& args) { return run_cli(args).code; }
 
 // Starts `segue train FILE` in the background.
-pid_t start_training(const std::string& file) {
-  pid_t pid = fork();
-  if (pid == 0) {
-    freopen("/dev/null", "w", stdout);
-    freopen("/dev/null", "w", stderr);
-    execl(SEGUE_BINARY, SEGUE_BINARY, "train", file.c_str(), static_cast<char*>(nullptr));
-    _exit(127);
-  }
-  return pid;
-}
-
 // Every column but the timings.
 void expect_same_rows(const std::vector<std::vector<std::string>>& a, const std::vector<std::vector<std::string>>& b) {
   ASSERT_EQ(a.size(), b.size());
@@ -106,7 +95,7 @@ TEST_F(Stages, ARunStoppedInTheSecondStageResumesToTheUnbrokenRunsRows) {
   const std::string longer = ", ppo: {total_steps: 12288}";
   ASSERT_EQ(run_segue("train " + recipe(longer, "unbroken")), 0);
   const std::string file = recipe(longer, "stopped");
-  pid_t pid = start_training(file);
+  pid_t pid = start_train(file);
   int status = 0;
   if (wait_until(pid, [&] { return std::filesystem::exists(path("stopped/2-second/checkpoint.pt")); }, &status)) {
     kill(pid, SIGTERM);

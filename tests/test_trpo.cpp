@@ -4,11 +4,6 @@
 // resumes to the unbroken one's policy, byte for byte; bad settings are refused in one line.
 #include <gtest/gtest.h>
 
-#include <signal.h>
-#include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <fstream>
 
 #include "algorithms/ppo.h"
@@ -150,29 +145,11 @@ class TrpoRuns : public TempDirTest {
   }
 };
 
-ino_t inode(const std::string& file) {
-  struct stat st {};
-  return ::stat(file.c_str(), &st) == 0 ? st.st_ino : 0;
-}
-
 TEST_F(TrpoRuns, KilledThreeTimesResumesToTheUnbrokenRunsPolicy) {
   ASSERT_EQ(run_cli("train " + recipe("unbroken")).code, 0);
   const std::string file = recipe("killed"), checkpoint = path("killed/checkpoint.pt");
-  for (int kill = 0; kill < 3; ++kill) {  // each in the rollout after a new checkpoint
-    const ino_t before = inode(checkpoint);
-    const pid_t pid = fork();
-    if (pid == 0) {
-      freopen("/dev/null", "w", stdout);
-      freopen("/dev/null", "w", stderr);
-      execl(SEGUE_BINARY, SEGUE_BINARY, "train", file.c_str(), static_cast<char*>(nullptr));
-      _exit(127);
-    }
-    int status = 0;
-    ASSERT_TRUE(wait_until(pid, [&] { return inode(checkpoint) != before && inode(checkpoint) != 0; }, &status))
-        << "the run ended by itself, status " << status;
-    ::kill(pid, SIGKILL);
-    ::waitpid(pid, &status, 0);
-  }
+  for (int kill = 0; kill < 3; ++kill)  // each in the rollout after a new checkpoint
+    ASSERT_TRUE(kill_after_next_checkpoint(file, checkpoint)) << "the run ended before kill " << kill;
   ASSERT_EQ(run_cli("train " + file).code, 0);
   auto a = csv(path("killed/metrics.csv")), b = csv(path("unbroken/metrics.csv"));
   ASSERT_EQ(a.size(), 9u);  // header and 8 iterations

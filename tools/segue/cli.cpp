@@ -4,6 +4,7 @@
 
 #include <torch/torch.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -11,6 +12,7 @@
 #include "core/distributed.h"
 #include "core/run_dir.h"
 #include "core/thread_pool.h"
+#include "environments/registry.h"
 
 namespace segue::cli {
 
@@ -79,8 +81,8 @@ std::vector<std::string> Args::all(const std::string& flag) const {
 
 std::string help_text(const Command& cmd) {
   std::ostringstream o;
-  o << "usage: segue " << cmd.name << " " << cmd.usage << "\n\n" << cmd.summary << "\n";
-  if (!cmd.flags.empty()) o << "\nflags:\n";
+  o << "usage: segue " << cmd.name << (cmd.usage.empty() ? "" : " " + cmd.usage) << "\n\n" << cmd.summary << "\n";
+  o << "\nflags:\n";
   for (const auto& f : cmd.flags) {
     std::string left = "--" + f.name + (f.value.empty() ? "" : " " + f.value);
     o << "  " << left << std::string(left.size() < 22 ? 22 - left.size() : 1, ' ') << f.help << "\n";
@@ -121,6 +123,36 @@ void require_same_recipe(const std::string& resolved, const std::string& file) {
   for (size_t r = 0; r < all.size(); ++r)
     if (!all[r].empty())
       throw Error(file + ": rank " + std::to_string(r) + " was started with another recipe than rank 0 (" + all[r] + ")");
+}
+
+std::vector<std::string> close_names(const std::string& name, const std::vector<std::string>& known) {
+  // The nearest by edit distance, if near enough; else the names holding it (or held by it).
+  std::vector<std::string> out;
+  const size_t limit = std::max<size_t>(2, name.size() / 4);
+  size_t best = limit + 1;
+  for (const auto& k : known) {
+    const size_t d = edit_distance(name, k);
+    if (d > limit) continue;
+    if (d < best) best = d, out.clear();
+    if (d == best) out.push_back(k);
+  }
+  if (out.empty() && name.size() >= 3)
+    for (const auto& k : known)
+      if (k.find(name) != std::string::npos || name.find(k) != std::string::npos) out.push_back(k);
+  if (out.size() > 3) out.resize(3);
+  return out;
+}
+
+void require_known_task(const std::string& task) {
+  const std::vector<std::string> known = task_names();
+  if (std::find(known.begin(), known.end(), task) != known.end()) return;
+  std::string hint, all;
+  const std::vector<std::string> near = close_names(task, known);
+  for (size_t i = 0; i < near.size(); ++i)
+    hint += (i == 0 ? "; did you mean '" : i + 1 == near.size() ? " or '" : ", '") + near[i] + "'";
+  if (!hint.empty()) hint += "?";
+  for (const auto& n : known) all += (all.empty() ? "" : ", ") + n;
+  throw Error("unknown task '" + task + "'" + hint + " (tasks: " + all + ")");
 }
 
 void set_torch_threads(int threads) {

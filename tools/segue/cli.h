@@ -73,6 +73,13 @@ void uninstall_stop_signals();
 // difference is refused on every rank, naming the first key that differs (`threads` may).
 void require_same_recipe(const std::string& resolved, const std::string& file);
 
+// The names in `known` a typo of `name` may have meant, at most three: those nearest by
+// edit distance where that is small, else those that contain it ("walker").
+std::vector<std::string> close_names(const std::string& name, const std::vector<std::string>& known);
+// Refuses a task name the registry does not know, in one line: "unknown task 'hurdel';
+// did you mean 'hurdle'? (tasks: ...)".
+void require_known_task(const std::string& task);
+
 // Sets LibTorch's intra-op threads; 0 means every core.
 void set_torch_threads(int threads);
 

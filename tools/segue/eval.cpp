@@ -1,6 +1,7 @@
 // segue eval: success and return over seeded episodes, for one policy on a task or for a
 // method (single, without-tp, ...) on a composite task.
 #include <cstdio>
+#include <filesystem>
 
 #include "core/thread_pool.h"
 #include "environments/registry.h"
@@ -36,6 +37,7 @@ int eval_main(int argc, char** argv) {
   if (args.help()) return print_help(kEval);
   if (!args.has("task")) throw Error("segue eval: --task NAME is required (see segue eval --help)");
   const std::string task = args.get("task", "");
+  require_known_task(task);
   const int episodes = args.get_int("episodes", 50, Range::positive());
   const int seed = args.get_int("seed", 0, Range::non_negative());
   const int threads = resolve_threads(args.get_int("threads", 0, Range::closed(0, kMaxThreads)));
@@ -51,7 +53,11 @@ int eval_main(int argc, char** argv) {
       if (method != "single") throw Error("segue eval: a POLICY argument only goes with --method single");
       sets.push_back("methods.single.policy=" + args.positional(0));
     }
-    composite = CompositeRecipe::load(args.get("recipe", CompositeRecipe::default_file(task)), sets);
+    const std::string file = args.get("recipe", CompositeRecipe::default_file(task));
+    if (!args.has("recipe") && !std::filesystem::exists(file))
+      throw Error("segue eval: task '" + task + "' has no composite recipe (experiments/" + task +
+                  ".yaml); --method is for composite tasks (or give --recipe FILE)");
+    composite = CompositeRecipe::load(file, sets);
     if (composite.task != task)
       throw Error(composite.file + ": key 'task' is '" + composite.task + "', not '" + task + "'");
     make = composite.make_env;

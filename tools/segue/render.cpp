@@ -291,6 +291,7 @@ int render_main(int argc, char** argv) {
   const std::string source = args.positional(0);
   if (!args.has("out") && !args.has("frames"))
     throw Error("segue render: --out FILE.mp4 or --frames DIR is required (see segue render --help)");
+  if (args.has("task")) require_known_task(args.get("task", ""));
   const int seed = args.get_int("seed", 0, Range::non_negative()),
             width = args.get_int("width", 640, Range::closed(16, 8192)),
             height = args.get_int("height", 480, Range::closed(16, 8192)),

@@ -41,6 +41,7 @@ int report_main(int argc, char** argv) {
   Args args(kReport, argc, argv);
   if (args.help()) return print_help(kReport);
   const std::string task = args.positional(0);
+  if (!args.has("recipe")) require_known_task(task);  // with --recipe, TASK only names the files
   CompositeRecipe r = CompositeRecipe::load(args.get("recipe", CompositeRecipe::default_file(task)));
   const int threads = resolve_threads(args.get_int("threads", 0, Range::closed(0, kMaxThreads)));
   set_torch_threads(1);

@@ -33,6 +33,12 @@ int run_main(int argc, char** argv) {
   if (args.help()) return print_help(kRun);
   auto sets = args.all("set");
   if (args.has("threads")) sets.push_back("threads=" + args.get("threads", "0"));
+  {
+    const Recipe probe = Recipe::load(args.positional(0), sets);
+    if (!probe.root().has("skills") && !probe.root().has("transitions"))
+      throw Error(args.positional(0) + ": a skill recipe (it has no 'skills:'); train it with 'segue train " +
+                  args.positional(0) + "'");
+  }
   CompositeRecipe recipe = CompositeRecipe::load(args.positional(0), sets);
   if (args.has("check")) return std::printf("%s: ok\n", args.positional(0).c_str()) < 0;
   require_same_recipe(recipe.resolved, args.positional(0));

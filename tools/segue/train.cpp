@@ -31,11 +31,11 @@ namespace {
 const Command kTrain{
     "train",
     "RECIPE [--set key=value ...]",
-    "Trains a skill with the recipe's learner (PPO or TRPO), or with an `es:` section\n"
-    "fine-tunes init_policy with"
-    " evolution strategies. Writes the run directory (recipe.yaml, metrics.csv,\n"
-    "checkpoint.pt, policy.pt, eval.json). Rerunning the same command after an\n"
-    "interruption resumes from the last checkpoint; a finished run is only re-evaluated.",
+    "Trains a skill with the recipe's learner (PPO, TRPO or SAC), or with an `es:` section\n"
+    "fine-tunes init_policy with evolution strategies. Writes the run directory\n"
+    "(recipe.yaml, metrics.csv, checkpoint.pt, policy.pt, eval.json). Rerunning the same\n"
+    "command after an interruption resumes from the last checkpoint; a finished run is\n"
+    "only re-evaluated. A composite recipe (with skills:) is for 'segue run'.",
     {"RECIPE"},
     {{"set", "key=value", "override a recipe key (repeatable), e.g. --set ppo.lr=1e-4", true},
      {"threads", "N", "threads for environments and LibTorch (overrides the recipe; 0 = all)"},
@@ -97,7 +97,11 @@ int train_es(const SkillRecipe& s, const Policy& start, const Recipe& recipe, co
   if (dir.has_checkpoint()) {
     std::vector<int64_t> counters = es.load(dir.checkpoint());
     if (counters.size() == 2) env_steps = counters[0], wall = counters[1] / 1000.0;
-    spdlog::info("resuming {} from generation {} ({} steps)", dir.path(), es.generation(), env_steps);
+    if (es.generation() >= cfg.generations)
+      spdlog::info("{} is finished ({} generations, {} steps); re-evaluating its policy", dir.path(),
+                   es.generation(), env_steps);
+    else
+      spdlog::info("resuming {} from generation {} ({} steps)", dir.path(), es.generation(), env_steps);
   } else {
     spdlog::info("fine-tuning {} on {} in {} with evolution strategies: {} generations of {} candidates x {} "
                  "episodes",
@@ -173,6 +177,10 @@ int train_main(int argc, char** argv) {
   auto sets = args.all("set");
   if (args.has("threads")) sets.push_back("threads=" + args.get("threads", "0"));
   Recipe recipe = Recipe::load(recipe_path, sets);
+  for (const char* composite_key : {"skills", "transitions"})
+    if (recipe.root().has(composite_key))
+      throw Error(recipe_path + ": a composite recipe (it has '" + composite_key + ":'); train it with 'segue run " +
+                  recipe_path + "'");
   const std::string default_run_dir = "runs/" + std::filesystem::path(recipe_path).stem().string();
   const bool check = args.has("check");
   if (!recipe.stages().empty()) return train_stages(recipe, default_run_dir, check);
@@ -373,6 +381,11 @@ int train_skill(const Recipe& recipe, const SkillRecipe& s) {
   if (resume) {
     make_dir();  // first: a different recipe is refused before its checkpoint is read
     learner->load_checkpoint(checkpoint, /*resume=*/true);
+    if (learner->global_step() >= total_steps) {  // nothing left to train: export and evaluate again
+      spdlog::info("{} is finished ({} steps); re-evaluating its policy", s.run_dir, learner->global_step());
+      if (!group.leader()) return 0;
+      return finish_run(learner->policy(), s, *dir, learner->global_step(), learner->wall_seconds(), threads);
+    }
     spdlog::info("resuming {} from iteration {} ({} steps)", s.run_dir, learner->iteration(), learner->global_step());
   } else if (!s.init_from.empty()) {
     const std::string from = repo_path(s.init_from);

@@ -1,0 +1,110 @@
+// With TP and With TP + Q (hrl/transition_controller.h): pi_ab drives exactly while the
+// interval holds (or for its max_steps), a q_ab that always switches is Without TP action
+// for action, and a q_ab trained with switch.interval_features reads the task's features.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "algorithms/mlp.h"
+#include "algorithms/policy.h"
+#include "hrl/composite_recipe.h"
+#include "hrl/transition_controller.h"
+#include "tests/transition_fixture.h"
+
+namespace segue {
+
+TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
+  CompositeRecipe r = tiny();
+  const Transition& tr = r.meta.transitions()[0];
+  std::vector<TransitionArtefacts> art(1);
+  art[0].policy = r.skills[tr.to].policy;  // any policy on balance's slice will do
+  auto env = r.make_env();
+  std::vector<float> obs(r.spec.obs_dim), act(6);
+  std::vector<double> f(r.spec.feature_names.size());
+  // With TP: pi_ab drives exactly while the interval holds, pi_b after it.
+  TransitionController tp(r.skills, r.meta, art, SwitchRule::IntervalEnd);
+  int driven = 0;
+  for (uint64_t seed = 0; seed < 20; ++seed) {  // an episode that starts walking forward
+    env->reset(seed, obs.data());
+    tp.reset(*env, obs.data());
+    if (tp.skill() == tr.from) break;
+  }
+  ASSERT_EQ(tp.skill(), tr.from);
+  for (int t = 0; t < 300; ++t) {
+    tp.act(*env, obs.data(), act.data());
+    env->features(f.data());
+    if (tp.transition() >= 0) {
+      ++driven;
+      ASSERT_TRUE(MetaController::holds(tr.when, f.data())) << t;
+      ASSERT_EQ(tp.skill(), tr.to);
+    }
+    if (env->step(act.data(), obs.data()).done()) break;
+  }
+  EXPECT_GT(driven, 0) << "the episode never reached the interval";
+  // With a cap (max_steps) shorter than the interval, pi_ab drives exactly that long.
+  CompositeRecipe capped = tiny({"transitions.0.max_steps=" + std::to_string(driven / 2)});
+  TransitionController tpc(capped.skills, capped.meta, art, SwitchRule::IntervalEnd);
+  for (uint64_t seed = 0;; ++seed) {  // the same episode
+    env->reset(seed, obs.data());
+    tpc.reset(*env, obs.data());
+    if (tpc.skill() == tr.from) break;
+  }
+  int capped_driven = 0;
+  for (int t = 0; t < 300; ++t) {
+    tpc.act(*env, obs.data(), act.data());
+    capped_driven += tpc.transition() >= 0;
+    if (env->step(act.data(), obs.data()).done()) break;
+  }
+  EXPECT_EQ(capped_driven, driven / 2);
+  // With TP + Q where q_ab always prefers switch: pi_b from the interval's first state,
+  // which is Without TP, action for action.
+  EigenMlp always_switch({torch::zeros({2, r.spec.obs_dim})}, {torch::tensor({0.0f, 1.0f})}, Activation::Relu);
+  art[0].q = Policy(always_switch, std::vector<float>(r.spec.obs_dim, 0.0f), std::vector<float>(r.spec.obs_dim, 1.0f),
+                    5.0f, {-1e9f, -1e9f}, {1e9f, 1e9f});
+  TransitionController tpq(r.skills, r.meta, art, SwitchRule::QNetwork);
+  auto without = method_controllers(r, "without-tp")();
+  auto e1 = r.make_env(), e2 = r.make_env();
+  std::vector<float> o1(obs.size()), o2(obs.size()), a1(6), a2(6);
+  e1->reset(77, o1.data());
+  e2->reset(77, o2.data());
+  tpq.reset(*e1, o1.data());
+  without->reset(*e2, o2.data());
+  for (int t = 0; t < 300; ++t) {
+    tpq.act(*e1, o1.data(), a1.data());
+    without->act(*e2, o2.data(), a2.data());
+    ASSERT_EQ(a1, a2) << t;
+    ASSERT_LT(tpq.transition(), 0);
+    if (e1->step(a1.data(), o1.data()).done() | e2->step(a2.data(), o2.data()).done()) break;
+  }
+  // switch.interval_features: a q_ab wider than the observation reads the task's features
+  // after it. This one, Q(stay) = 0.2 and Q(switch) = 0.01 since_turn, hands over at the
+  // interval's first state with since_turn > 20, where With TP's pi_ab drove on.
+  const int D = r.spec.obs_dim, F = int(f.size());
+  ASSERT_EQ(r.spec.feature_names[1], "since_turn");
+  ASSERT_GT(driven, 25) << "With TP's pi_ab must drive past since_turn 20 for this check";
+  torch::Tensor w = torch::zeros({2, D + F});
+  w[1][D + 1] = 1.0f;
+  std::vector<float> inv_std(D + F, 1.0f);
+  inv_std[D + 1] = 0.01f;
+  art[0].q = Policy(EigenMlp({w}, {torch::tensor({0.2f, 0.0f})}, Activation::Relu), std::vector<float>(D + F, 0.0f),
+                    inv_std, 5.0f, {-1e9f, -1e9f}, {1e9f, 1e9f});
+  TransitionController by_time(r.skills, r.meta, art, SwitchRule::QNetwork);
+  for (uint64_t seed = 0;; ++seed) {  // With TP's episode
+    env->reset(seed, obs.data());
+    by_time.reset(*env, obs.data());
+    if (by_time.skill() == tr.from) break;
+  }
+  int handed_at = -1;
+  bool begun = false;
+  for (int t = 0; t < 300 && handed_at < 0; ++t) {
+    by_time.act(*env, obs.data(), act.data());
+    env->features(f.data());
+    if (by_time.transition() >= 0) begun = true;
+    else if (begun) handed_at = int(f[1]);
+    if (env->step(act.data(), obs.data()).done()) break;
+  }
+  EXPECT_EQ(handed_at, 21);
+}
+
+}  // namespace segue
