@@ -165,7 +165,7 @@ SAC::UpdateStats SAC::update(const ReplayBuffer::Batch& b) {
   return {ql, pi_loss.item<double>(), -logp.mean().item<double>(), q1v.mean().item<double>()};
 }
 
-void SAC::collect(int steps_per_env, IterationStats& stats) {
+void SAC::collect(int steps_per_env) {
   const int n = envs_.size(), d = spec_.obs_dim, a = spec_.act_dim;
   const auto& low = envs_.spec().act_low;
   const auto& high = envs_.spec().act_high;
@@ -210,7 +210,7 @@ IterationStats SAC::iterate() {
   std::vector<int64_t> idx(cfg_.batch_size);
   for (int round = 0; round < cfg_.steps_per_iteration / cfg_.update_every; ++round) {
     auto t0 = std::chrono::steady_clock::now();
-    collect(cfg_.update_every / envs_.size(), stats);
+    collect(cfg_.update_every / envs_.size());
     auto t1 = std::chrono::steady_clock::now();
     if (replay_.size() >= std::max<int64_t>(cfg_.update_after, 1)) {
       for (int k = 0; k < cfg_.update_every; ++k) {

@@ -86,7 +86,7 @@ class SAC : public Learner {
   // a = tanh(u), u ~ N(mu, sigma): the action in [-1, 1]^A and log pi(a|s).
   std::pair<torch::Tensor, torch::Tensor> sample(const torch::Tensor& obs);
   torch::Tensor q(torch::nn::Sequential& net, const torch::Tensor& obs, const torch::Tensor& act);
-  void collect(int steps_per_env, IterationStats& stats);
+  void collect(int steps_per_env);  // steps every environment, storing each transition
   void masked(const float* raw, float* out) const;  // the networks' input: ignored inputs 0
   void refresh_inference_copy();
   void write(torch::serialize::OutputArchive& ar) const;
