@@ -25,6 +25,8 @@ std::vector<T> to_vector(const torch::Tensor& t, torch::ScalarType dtype) {
 std::vector<float> to_floats(const torch::Tensor& t) { return to_vector<float, float>(t, torch::kFloat32); }
 std::vector<double> to_doubles(const torch::Tensor& t) { return to_vector<double, double>(t, torch::kFloat64); }
 std::vector<int> to_ints(const torch::Tensor& t) { return to_vector<int, int64_t>(t, torch::kLong); }
+torch::Tensor int64_tensor(const std::vector<int64_t>& v) { return torch::tensor(v, torch::kLong); }
+torch::Tensor int_tensor(const std::vector<int>& v) { return int64_tensor({v.begin(), v.end()}); }
 std::vector<int64_t> to_int64s(const torch::Tensor& t) { return to_vector<int64_t, int64_t>(t, torch::kLong); }
 
 torch::Tensor text_tensor(const std::string& s) {

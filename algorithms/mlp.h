@@ -21,6 +21,9 @@ std::vector<float> to_floats(const torch::Tensor& t);
 std::vector<double> to_doubles(const torch::Tensor& t);
 std::vector<int> to_ints(const torch::Tensor& t);
 std::vector<int64_t> to_int64s(const torch::Tensor& t);
+// And back, as int64 tensors (how archives keep integers).
+torch::Tensor int64_tensor(const std::vector<int64_t>& v);
+torch::Tensor int_tensor(const std::vector<int>& v);
 // Text in an archive: one int64 per character.
 torch::Tensor text_tensor(const std::string& s);
 std::string to_text(const torch::Tensor& t);

@@ -124,7 +124,8 @@ class OnPolicyLearner : public Learner {
   void save(const std::string& path, const std::string& note) const override { save(path, note, ArchiveWriter()); }
   void save(const std::string& path) const { save(path, "", ArchiveWriter()); }
   void load_checkpoint(const std::string& path, bool resume) override { load(path, {}, resume); }
-  static Policy policy_from_checkpoint(const std::string& path);
+  // The deterministic policy of a checkpoint already read.
+  static Policy policy_from_checkpoint(torch::serialize::InputArchive& ar);
 
  protected:
   // One permutation of the whole rollout (every rank's rows, as one process would draw

@@ -16,12 +16,10 @@ std::string key(std::string name) {
     if (c == '.') c = '_';
   return "ac_" + name;
 }
-torch::Tensor ints(const std::vector<int64_t>& v) { return torch::tensor(v, torch::kLong); }
-std::vector<int64_t> widen(const std::vector<int>& v) { return {v.begin(), v.end()}; }
 // The periodic features, if any (older checkpoints have none).
 void write_features(torch::serialize::OutputArchive& ar, const ObsFeatures& f) {
   if (f.empty()) return;
-  ar.write("meta_feature_inputs", ints(widen(f.inputs)));
+  ar.write("meta_feature_inputs", int_tensor(f.inputs));
   ar.write("meta_feature_periods", torch::tensor(f.periods, torch::kFloat64));
 }
 ObsFeatures read_features(torch::serialize::InputArchive& ar) {
@@ -94,10 +92,10 @@ void OnPolicyLearner::save(const std::string& path, const std::string& note, con
   obs_rms_.save(ar, "obs_rms_");
   return_rms_.save(ar, "return_rms_");
   const auto& s = net_->spec;
-  ar.write("meta_counters", ints({iteration_, global_step_, int64_t(wall_seconds_ * 1000), schedule_start_}));
-  ar.write("meta_dims", ints({s.obs_dim, s.act_dim, s.activation == Activation::Tanh ? 0 : 1}));
-  ar.write("meta_pi_hidden", ints(widen(s.pi_hidden)));
-  ar.write("meta_vf_hidden", ints(widen(s.vf_hidden)));
+  ar.write("meta_counters", int64_tensor({iteration_, global_step_, int64_t(wall_seconds_ * 1000), schedule_start_}));
+  ar.write("meta_dims", int64_tensor({s.obs_dim, s.act_dim, s.activation == Activation::Tanh ? 0 : 1}));
+  ar.write("meta_pi_hidden", int_tensor(s.pi_hidden));
+  ar.write("meta_vf_hidden", int_tensor(s.vf_hidden));
   write_features(ar, s.features);
   ar.write("meta_act_low", torch::tensor(envs_.spec().act_low));
   ar.write("meta_act_high", torch::tensor(envs_.spec().act_high));
@@ -210,9 +208,7 @@ void OnPolicyLearner::read_state(torch::serialize::InputArchive& ar, const std::
   schedule_start_ = counters.numel() > 3 ? counters[3].item<int64_t>() : 0;  // older checkpoints: 0
 }
 
-Policy OnPolicyLearner::policy_from_checkpoint(const std::string& path) {
-  torch::serialize::InputArchive ar;
-  ar.load_from(path);
+Policy OnPolicyLearner::policy_from_checkpoint(torch::serialize::InputArchive& ar) {
   torch::Tensor dims, pi, vf, low, high;
   ar.read("meta_dims", dims);
   ar.read("meta_pi_hidden", pi);

@@ -155,8 +155,8 @@ Policy checkpoint_policy(const std::string& path) {
   torch::serialize::InputArchive ar;
   ar.load_from(path);
   torch::Tensor learner;
-  if (ar.try_read("meta_learner", learner) && to_text(learner) == "sac") return SAC::policy_from_checkpoint(path);
-  return OnPolicyLearner::policy_from_checkpoint(path);
+  if (ar.try_read("meta_learner", learner) && to_text(learner) == "sac") return SAC::policy_from_checkpoint(ar, path);
+  return OnPolicyLearner::policy_from_checkpoint(ar);
 }
 
 }  // namespace

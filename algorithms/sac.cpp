@@ -44,7 +44,6 @@ void copy_parameters(const torch::nn::Sequential& from, torch::nn::Sequential& t
   for (size_t i = 0; i < src.size(); ++i) dst[i].copy_(src[i]);
 }
 
-std::vector<int64_t> widen(const std::vector<int>& v) { return {v.begin(), v.end()}; }
 
 // The actor's mean head as an EigenMlp: its last layer's first act_dim rows.
 EigenMlp mean_head(const torch::nn::Sequential& actor, int act_dim, Activation act) {
@@ -284,7 +283,6 @@ void read_optimizer(torch::serialize::InputArchive& ar, const std::string& name,
   ar.read(name, sub);
   o.load(sub);
 }
-torch::Tensor ints(const std::vector<int64_t>& v) { return torch::tensor(v, torch::kLong); }
 
 }  // namespace
 
@@ -298,11 +296,11 @@ void SAC::write(torch::serialize::OutputArchive& ar) const {
   write_optimizer(ar, "alpha_optimizer", *alpha_opt_);
   replay_.save(ar);
   ar.write("meta_learner", text_tensor(name_));
-  ar.write("meta_counters", ints({iteration_, global_step_, int64_t(wall_seconds_ * 1000)}));
-  ar.write("meta_dims", ints({spec_.obs_dim, spec_.act_dim, spec_.activation == Activation::Tanh ? 0 : 1}));
-  ar.write("meta_pi_hidden", ints(widen(spec_.pi_hidden)));
-  ar.write("meta_vf_hidden", ints(widen(spec_.vf_hidden)));
-  ar.write("meta_ignore_obs", ints(widen(spec_.ignore_obs)));
+  ar.write("meta_counters", int64_tensor({iteration_, global_step_, int64_t(wall_seconds_ * 1000)}));
+  ar.write("meta_dims", int64_tensor({spec_.obs_dim, spec_.act_dim, spec_.activation == Activation::Tanh ? 0 : 1}));
+  ar.write("meta_pi_hidden", int_tensor(spec_.pi_hidden));
+  ar.write("meta_vf_hidden", int_tensor(spec_.vf_hidden));
+  ar.write("meta_ignore_obs", int_tensor(spec_.ignore_obs));
   ar.write("meta_act_low", torch::tensor(envs_.spec().act_low));
   ar.write("meta_act_high", torch::tensor(envs_.spec().act_high));
 }
@@ -366,9 +364,7 @@ void SAC::load_checkpoint(const std::string& path, bool resume) {
   refresh_inference_copy();
 }
 
-Policy SAC::policy_from_checkpoint(const std::string& path) {
-  torch::serialize::InputArchive ar;
-  ar.load_from(path);
+Policy SAC::policy_from_checkpoint(torch::serialize::InputArchive& ar, const std::string& path) {
   torch::Tensor dims, pi, ignore, low, high;
   ar.read("meta_dims", dims);
   ar.read("meta_pi_hidden", pi);

@@ -70,7 +70,8 @@ class SAC : public Learner {
   // counters and the episodes in flight.
   void save(const std::string& path, const std::string& note) const override;
   void load_checkpoint(const std::string& path, bool resume) override;
-  static Policy policy_from_checkpoint(const std::string& path);
+  // The deterministic policy of a checkpoint already read (`path` names it in errors).
+  static Policy policy_from_checkpoint(torch::serialize::InputArchive& ar, const std::string& path);
 
   // One gradient update on a batch (public for tests): returns Q loss, policy loss,
   // entropy estimate and mean Q.

@@ -104,7 +104,7 @@ struct KeyWalk {
   }
 };
 
-void refuse_bad_keys(const YAML::Node& node, const std::string& file) { KeyWalk{file}.walk(node, ""); }
+void refuse_bad_keys(const YAML::Node& node, const std::string& file) { KeyWalk{file, {}}.walk(node, ""); }
 
 void collect_leaves(const YAML::Node& node, const std::string& prefix, std::vector<std::string>& out) {
   if (node.IsMap() && node.size() > 0) {

@@ -67,7 +67,7 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
         part = StartStates();
         part.obs_dim = out.obs_dim;
         w.env->reset(mix_seed(seed, e), w.obs.data());
-        w.controller->reset(*w.env, w.obs.data());
+        w.controller->reset(*w.env, w.obs.data(), mix_seed(seed, e));
         for (bool done = false; !done;) {
           // The interval a->b begins where the meta-controller hands a's phase to b. That
           // phase may be driven by a transition policy into a rather than by pi_a itself:

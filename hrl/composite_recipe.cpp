@@ -77,6 +77,8 @@ CompositeRecipe CompositeRecipe::load(const std::string& file, const std::vector
   c.eval_episodes = ev.get("episodes", c.eval_episodes, Range::positive());
   c.eval_seeds = ev.get("seeds", c.eval_seeds, Range::non_negative());
   if (c.eval_seeds.empty()) throw ev.error("seeds", "lists no seed");
+  c.handover_point = ev.choice("handover_point", "fixed", {"fixed", "random"}) == "random" ? HandOverPoint::Random
+                                                                                          : HandOverPoint::Fixed;
   recipe.reject_unknown();
   c.resolved = recipe.resolved_yaml();
   c.defaulted = recipe.defaulted_keys();
@@ -139,11 +141,12 @@ std::vector<TransitionArtefacts> load_transition_artefacts(const CompositeRecipe
 
 ControllerFactory method_controllers(const CompositeRecipe& r, const std::string& method) {
   if (method == "without-tp") {
-    // The meta-controller switches straight to the next skill as the interval begins:
-    // transition controllers with no transition policy trained.
+    // Transition controllers with no transition policy trained: the meta-controller
+    // switches straight to the next skill as the interval begins (or, at a random hand-over
+    // point, lets the skill before it carry on until then).
     return [&r] {
       return std::make_unique<TransitionController>(r.skills, r.meta, std::vector<TransitionArtefacts>{},
-                                                    SwitchRule::IntervalEnd);
+                                                    SwitchRule::IntervalEnd, r.handover_point);
     };
   }
   if (method == "single") {
@@ -180,7 +183,9 @@ ControllerFactory method_controllers(const CompositeRecipe& r, const std::string
     SwitchRule rule = method == "tp" ? SwitchRule::IntervalEnd
                       : method == "tp+q" ? SwitchRule::QNetwork
                                          : SwitchRule::TerminationHead;
-    return [&r, artefacts, rule] { return std::make_unique<TransitionController>(r.skills, r.meta, artefacts, rule); };
+    return [&r, artefacts, rule] {
+      return std::make_unique<TransitionController>(r.skills, r.meta, artefacts, rule, r.handover_point);
+    };
   }
   std::string known;
   for (const auto& m : method_names()) known += (known.empty() ? "" : ", ") + m;

@@ -15,7 +15,7 @@
 //   methods:
 //     single: {policy: assets/policies/walker/single/hurdle.pt}
 //     transitions: assets/policies/walker/hurdle   # NAME/policy.pt, q.pt per transition
-//   eval: {episodes: 50, seeds: [0, 1, 2]}
+//   eval: {episodes: 50, seeds: [0, 1, 2], handover_point: fixed}
 //   ... and the pipeline's settings (hrl/pipeline_config.h).
 #include <set>
 #include <string>
@@ -48,6 +48,9 @@ struct CompositeRecipe {
   std::map<std::string, KeyRule> key_rules;  // each key's type and range (segue keys)
   int eval_episodes = 50;
   std::vector<int> eval_seeds{0, 1, 2};
+  // Where Without TP and With TP hand over (eval.handover_point): fixed, as the paper's text
+  // says, or at a uniform random point of the interval, as the reference code evaluates.
+  HandOverPoint handover_point = HandOverPoint::Fixed;
 
   // Reads and validates everything (missing skills or policies, sizes that do not fit),
   // then refuses unknown keys.

@@ -12,8 +12,9 @@ namespace segue {
 class Controller {
  public:
   virtual ~Controller() = default;
-  // A new episode has started in `env` with observation `obs`.
-  virtual void reset(const Env& env, const float* obs) {}
+  // A new episode has started in `env` with observation `obs`; `seed` is the episode's, for
+  // a controller that draws random numbers of its own.
+  virtual void reset(const Env& env, const float* obs, uint64_t seed) {}
   virtual void act(const Env& env, const float* obs, float* action) = 0;
 };
 

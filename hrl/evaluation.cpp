@@ -56,7 +56,7 @@ EvalResult run_jobs(const EnvFactory& make_env, int jobs, const std::function<ui
     if (job_of[s] < 0) return;
     controller[s] = &controller_for(s, job_of[s]);
     envs[s]->reset(seed_of(job_of[s]), &obs[size_t(s) * D]);
-    controller[s]->reset(*envs[s], &obs[size_t(s) * D]);
+    controller[s]->reset(*envs[s], &obs[size_t(s) * D], seed_of(job_of[s]));
   };
   for (int s = 0; s < slots; ++s) start(s);
   std::optional<Progress> progress;

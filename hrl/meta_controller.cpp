@@ -1,6 +1,7 @@
 #include "hrl/meta_controller.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace segue {
 namespace {
@@ -93,6 +94,13 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
 
 bool Transition::running(const double* features, int steps) const {
   return !capped(steps) && MetaController::holds(when, features);
+}
+
+double Transition::progress(const double* entry, const double* f, int steps) const {
+  if (max_steps > 0) return double(steps) / max_steps;
+  for (const Condition& c : when)
+    if (c.hi > c.lo) return std::abs(f[c.feature] - entry[c.feature]) / (c.hi - c.lo);
+  return 1.0;
 }
 
 Transition Transition::training_window() const {

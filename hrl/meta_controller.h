@@ -59,6 +59,11 @@ struct Transition {
   bool capped(int steps) const { return max_steps > 0 && steps >= max_steps; }
   // Whether a transition policy that has taken `steps` steps in the interval keeps control.
   bool running(const double* features, int steps) const;
+  // How far through the interval a hand-over `steps` steps in, at `features`, is: 0 where it
+  // was entered (at `entry`), 1 at its far side. Over max_steps for a capped transition,
+  // else over the first condition with a width, as the distance its feature has moved
+  // (curb_ahead 4 -> 3.5 is halfway through [3, 4]); 1 (at once) for equalities alone.
+  double progress(const double* entry, const double* features, int steps) const;
   // The window pi_ab's own training episodes run in (`training: {when: ..., max_steps: N}`;
   // by default the interval): episodes start at S_a, where the interval begins, and may run
   // on past where the switch must hand over, so that pi_ab does not learn to hand over at

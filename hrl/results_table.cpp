@@ -72,7 +72,11 @@ void write_results(const CompositeRecipe& r, const std::vector<MethodResult>& re
   json << "{\n";
   md << "# " << r.task << ": success count\n\n"
      << "Mean +- std of the success count over " << r.eval_episodes << " episodes for each of "
-     << r.eval_seeds.size() << " evaluation seeds (pooled), with per-seed means.\n"
+     << r.eval_seeds.size() << " evaluation seeds (pooled), with per-seed means. Without TP and With TP hand over "
+     << (r.handover_point == HandOverPoint::Random
+             ? "at a uniform random point of the interval, as the reference code evaluates them"
+             : "as the interval begins and ends, as the paper's text says")
+     << " (eval.handover_point).\n"
      << "Measured with `" << command << "` (recipe " << std::filesystem::path(r.file).filename().string()
      << ").\n\n| method | success count | per-seed means |\n|---|---|---|\n";
   std::vector<double> seeds(r.eval_seeds.begin(), r.eval_seeds.end());

@@ -3,13 +3,16 @@
 namespace segue {
 
 TransitionController::TransitionController(const std::vector<Skill>& skills, const MetaController& meta,
-                                           std::vector<TransitionArtefacts> artefacts, SwitchRule rule)
-    : skills_(skills), meta_(meta), artefacts_(std::move(artefacts)), rule_(rule) {
+                                           std::vector<TransitionArtefacts> artefacts, SwitchRule rule,
+                                           HandOverPoint point)
+    : skills_(skills), meta_(meta), artefacts_(std::move(artefacts)), rule_(rule), point_(point) {
   artefacts_.resize(meta_.transitions().size());  // those not given: Without TP
 }
 
-void TransitionController::reset(const Env& env, const float*) {
+void TransitionController::reset(const Env& env, const float*, uint64_t seed) {
+  rng_.seed(mix_seed(seed, 0x68616e64));  // a stream of its own, apart from the task's
   features_.resize(env.spec().feature_names.size());
+  entry_features_.resize(features_.size());
   env.features(features_.data());
   resume(env, meta_.start_skill(features_.data()));
 }
@@ -29,6 +32,9 @@ void TransitionController::resume(const Env& env, int skill) {
 }
 
 bool TransitionController::hand_over(const float* obs) {
+  if (rule_ == SwitchRule::IntervalEnd && point_ == HandOverPoint::Random)
+    return meta_.transitions()[transition_].progress(entry_features_.data(), features_.data(), steps_) >=
+           hand_over_at_;
   const TransitionArtefacts& a = artefacts_[transition_];
   if (rule_ == SwitchRule::QNetwork && a.q) {
     float q[2];
@@ -56,8 +62,13 @@ void TransitionController::act(const Env& env, const float* obs, float* action) 
       entered_ = t;
       taken_[t] = 1;
       skill_ = meta_.transitions()[t].to;  // pi_b is next, whoever drives the interval
-      if (artefacts_[t].policy) {
+      const bool random = rule_ == SwitchRule::IntervalEnd && point_ == HandOverPoint::Random;
+      if (artefacts_[t].policy || random) {
         transition_ = t, steps_ = 0;
+        if (random) {
+          hand_over_at_ = rng_.uniform(0.0, 1.0);
+          entry_features_ = features_;
+        }
         if (hand_over(obs)) transition_ = -1;  // q_ab may switch at the interval's first state
       }
     }
@@ -65,6 +76,12 @@ void TransitionController::act(const Env& env, const float* obs, float* action) 
   const Skill& b = skills_[skill_];
   if (transition_ < 0) {
     b.policy.act(obs + b.obs_begin, 1, action);
+    return;
+  }
+  if (!artefacts_[transition_].policy) {  // Without TP, a random hand-over point: pi_a until then
+    const Skill& a = skills_[meta_.transitions()[transition_].from];
+    a.policy.act(obs + a.obs_begin, 1, action);
+    ++steps_;
     return;
   }
   const Policy& pi_ab = *artefacts_[transition_].policy;

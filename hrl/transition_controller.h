@@ -7,11 +7,17 @@
 //   TerminationHead  (Lee et al.):    when pi_ab's extra output (its termination head) is
 //                                     positive.
 // Control always passes to pi_b when the interval ends (or its max_steps are spent). A
-// transition without a trained pi_ab is taken as Without TP.
+// transition without a trained pi_ab is taken as Without TP: pi_b from the interval's start.
+//
+// The reference code evaluates Without TP and With TP otherwise (HandOverPoint::Random):
+// control passes to pi_b at a point of the interval drawn uniformly (Transition::progress),
+// pi_ab driving until then (With TP) or pi_a carrying on (Without TP). With TP + Q and Lee
+// et al. decide for themselves either way.
 #include <algorithm>
 #include <optional>
 #include <vector>
 
+#include "core/rng.h"
 #include "hrl/controller.h"
 #include "hrl/meta_controller.h"
 #include "hrl/skill.h"
@@ -19,6 +25,9 @@
 namespace segue {
 
 enum class SwitchRule { IntervalEnd, QNetwork, TerminationHead };
+// Where Without TP and With TP hand over to pi_b (recipe key eval.handover_point):
+// Fixed as the paper's text (at the interval's start / end), Random as the reference code.
+enum class HandOverPoint { Fixed, Random };
 
 struct TransitionArtefacts {
   std::optional<Policy> policy;  // pi_ab, on pi_b's observation slice
@@ -37,15 +46,16 @@ inline void switch_input(const float* obs, int obs_dim, const std::vector<double
 class TransitionController : public Controller {
  public:
   TransitionController(const std::vector<Skill>& skills, const MetaController& meta,
-                       std::vector<TransitionArtefacts> artefacts, SwitchRule rule);
-  void reset(const Env& env, const float* obs) override;
+                       std::vector<TransitionArtefacts> artefacts, SwitchRule rule,
+                       HandOverPoint point = HandOverPoint::Fixed);
+  void reset(const Env& env, const float* obs, uint64_t seed) override;
   // Carries on an episode already under way with `skill` in control and no transition
   // running (switch training hands the episode over here after pi_ab). An interval into
   // `skill` that holds now is the one just handed over in: it is not entered again.
   void resume(const Env& env, int skill);
   void act(const Env& env, const float* obs, float* action) override;
   int skill() const { return skill_; }
-  int transition() const { return transition_; }  // the transition pi_ab is running, or -1
+  int transition() const { return transition_; }  // the transition pi_ab (or pi_a) drives, or -1
   // The transition whose interval the last act() entered (control passed to pi_ab, or
   // straight to pi_b), or -1.
   int entered() const { return entered_; }
@@ -56,7 +66,10 @@ class TransitionController : public Controller {
   const MetaController& meta_;
   std::vector<TransitionArtefacts> artefacts_;  // per transition of the recipe
   SwitchRule rule_;
-  std::vector<double> features_;
+  HandOverPoint point_;
+  Rng rng_;                  // the random hand-over points, from the episode's seed
+  double hand_over_at_ = 1;  // the drawn point (HandOverPoint::Random), in Transition::progress
+  std::vector<double> features_, entry_features_;
   std::vector<float> out_, q_in_;
   int obs_dim_ = 0;
   int skill_ = 0, transition_ = -1, steps_ = 0;  // steps_: pi_ab's in this interval

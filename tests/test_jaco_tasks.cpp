@@ -235,7 +235,7 @@ TEST(RepetitivePicking, ThePickHandsOverToItselfOncePerSuccess) {
   TransitionController without_tp(r.skills, r.meta, {}, SwitchRule::IntervalEnd);
   std::vector<float> obs(49), act(9);
   env->reset(7, obs.data());
-  without_tp.reset(*env, obs.data());
+  without_tp.reset(*env, obs.data(), 0);
   std::vector<int> entered_at;
   for (int t = 0; t < 400; ++t) {
     without_tp.act(*env, obs.data(), act.data());

@@ -1,8 +1,12 @@
 // With TP and With TP + Q (hrl/transition_controller.h): pi_ab drives exactly while the
 // interval holds (or for its max_steps), a q_ab that always switches is Without TP action
-// for action, and a q_ab trained with switch.interval_features reads the task's features.
+// for action, and a q_ab trained with switch.interval_features reads the task's features;
+// at a random hand-over point, pi_ab or pi_a drives to a point drawn uniformly.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -27,7 +31,7 @@ TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
   int driven = 0;
   for (uint64_t seed = 0; seed < 20; ++seed) {  // an episode that starts walking forward
     env->reset(seed, obs.data());
-    tp.reset(*env, obs.data());
+    tp.reset(*env, obs.data(), 0);
     if (tp.skill() == tr.from) break;
   }
   ASSERT_EQ(tp.skill(), tr.from);
@@ -47,7 +51,7 @@ TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
   TransitionController tpc(capped.skills, capped.meta, art, SwitchRule::IntervalEnd);
   for (uint64_t seed = 0;; ++seed) {  // the same episode
     env->reset(seed, obs.data());
-    tpc.reset(*env, obs.data());
+    tpc.reset(*env, obs.data(), 0);
     if (tpc.skill() == tr.from) break;
   }
   int capped_driven = 0;
@@ -68,8 +72,8 @@ TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
   std::vector<float> o1(obs.size()), o2(obs.size()), a1(6), a2(6);
   e1->reset(77, o1.data());
   e2->reset(77, o2.data());
-  tpq.reset(*e1, o1.data());
-  without->reset(*e2, o2.data());
+  tpq.reset(*e1, o1.data(), 0);
+  without->reset(*e2, o2.data(), 0);
   for (int t = 0; t < 300; ++t) {
     tpq.act(*e1, o1.data(), a1.data());
     without->act(*e2, o2.data(), a2.data());
@@ -92,7 +96,7 @@ TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
   TransitionController by_time(r.skills, r.meta, art, SwitchRule::QNetwork);
   for (uint64_t seed = 0;; ++seed) {  // With TP's episode
     env->reset(seed, obs.data());
-    by_time.reset(*env, obs.data());
+    by_time.reset(*env, obs.data(), 0);
     if (by_time.skill() == tr.from) break;
   }
   int handed_at = -1;
@@ -105,6 +109,83 @@ TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
     if (env->step(act.data(), obs.data()).done()) break;
   }
   EXPECT_EQ(handed_at, 21);
+}
+
+// eval.handover_point: random, the reference code's protocol. In each episode With TP's
+// pi_ab, and Without TP's pi_a, drive forward->balance's interval (here steps 20 to 120 of
+// the episode) up to a point drawn uniformly over it, then pi_b; Without TP acts as pi_a
+// and then as pi_b, action for action. Over the episodes the points spread over the whole
+// interval, and the same episode seed draws the same point.
+TEST_F(TransitionTraining, ARandomHandOverPointIsDrawnUniformlyOverTheInterval) {
+  std::string text = kTinyPatrol;
+  const std::string interval = "when: {since_turn: [0, 100]}";
+  ASSERT_NE(text.find(interval), std::string::npos);
+  text.replace(text.find(interval), interval.size(), "when: {steps: [20, 120]}");
+  std::ofstream(path("by_steps.yaml")) << text;
+  CompositeRecipe r = CompositeRecipe::load(path("by_steps.yaml"), {"eval.handover_point=random", "run_dir=" + path("run")});
+  ASSERT_EQ(r.handover_point, HandOverPoint::Random);
+  const Transition& tr = r.meta.transitions()[0];
+  const Skill &a = r.skills[tr.from], &b = r.skills[tr.to];
+  ASSERT_EQ(r.spec.feature_names[3], "steps");
+  std::vector<TransitionArtefacts> art(1);
+  art[0].policy = b.policy;  // any policy on balance's slice will do
+  auto with_tp = std::make_unique<TransitionController>(r.skills, r.meta, art, SwitchRule::IntervalEnd, r.handover_point);
+  auto without = method_controllers(r, "without-tp")();
+  auto& without_tp = dynamic_cast<TransitionController&>(*without);
+  auto env = r.make_env();
+  std::vector<float> obs(r.spec.obs_dim), act(6), own(6);
+  std::vector<double> f(r.spec.feature_names.size());
+  // Runs an episode that starts walking forward from `seed` (false if it starts backward);
+  // *point: where in the interval control passed to pi_b (NAN if it never did inside it).
+  auto episode = [&](TransitionController& c, uint64_t seed, double* point, int* driven) {
+    env->reset(seed, obs.data());
+    c.reset(*env, obs.data(), seed);
+    if (c.skill() != tr.from) return false;
+    *point = NAN, *driven = 0;
+    for (int t = 0; t < 300; ++t) {
+      env->features(f.data());
+      const bool in_interval = MetaController::holds(tr.when, f.data());
+      c.act(*env, obs.data(), act.data());
+      if (c.transition() >= 0) {
+        ++*driven;
+        EXPECT_TRUE(in_interval) << t;
+        if (&c == &without_tp) {
+          a.policy.act(obs.data() + a.obs_begin, 1, own.data());
+          EXPECT_EQ(act, own) << "Without TP: pi_a drives until the point, step " << t;
+        }
+      } else if (*driven > 0) {
+        if (in_interval) *point = (f[3] - 20) / 100;
+        if (&c == &without_tp) {
+          b.policy.act(obs.data() + b.obs_begin, 1, own.data());
+          EXPECT_EQ(act, own) << "Without TP: pi_b after the point, step " << t;
+        }
+        return true;
+      }
+      if (env->step(act.data(), obs.data()).done()) break;
+    }
+    return true;
+  };
+  for (TransitionController* c : {with_tp.get(), &without_tp}) {
+    std::vector<double> points;
+    double point;
+    int driven;
+    for (uint64_t seed = 0; seed < 60; ++seed)
+      if (episode(*c, seed, &point, &driven) && !std::isnan(point)) points.push_back(point);
+    ASSERT_GE(points.size(), 10u) << (c == &without_tp ? "Without TP" : "With TP");
+    double mean = 0;
+    for (double p : points) mean += p / points.size();
+    // U(0, 1): mean 1/2 with a standard error of 0.29 / sqrt(n); both ends reached.
+    EXPECT_NEAR(mean, 0.5, 4 * 0.29 / std::sqrt(double(points.size()))) << points.size() << " episodes";
+    EXPECT_LT(*std::min_element(points.begin(), points.end()), 0.25);
+    EXPECT_GT(*std::max_element(points.begin(), points.end()), 0.75);
+  }
+  double first, again;
+  int driven_first, driven_again;
+  uint64_t seed = 0;
+  while (!episode(*with_tp, seed, &first, &driven_first)) ++seed;
+  episode(*with_tp, seed, &again, &driven_again);
+  EXPECT_EQ(driven_first, driven_again);
+  EXPECT_GT(driven_first, 0);
 }
 
 }  // namespace segue

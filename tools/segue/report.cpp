@@ -16,7 +16,7 @@ namespace {
 
 const Command kReport{
     "report",
-    "TASK [--methods a,b] [--recipe FILE] [--out DIR]",
+    "TASK [--methods a,b] [--recipe FILE] [--set key=value ...] [--out DIR]",
     "Evaluates methods of the paper on a composite task over the recipe's evaluation seeds\n"
     "and episodes, and writes DIR/TASK.md (a table in the paper's layout) and DIR/TASK.json\n"
     "(method -> mean, std, per_seed_means, per_seed_stds, episodes, seeds), and DIR/TASK.png,\n"
@@ -24,6 +24,7 @@ const Command kReport{
     {"TASK"},
     {{"methods", "a,b", "methods to run (default: every method whose artefacts exist)"},
      {"recipe", "FILE", "composite recipe (default experiments/TASK.yaml)"},
+     {"set", "key=value", "override a recipe key, e.g. --set eval.handover_point=random (repeatable)", true},
      {"out", "DIR", "output folder (default experiments/results in the source tree)"},
      {"threads", "N", "threads stepping environments (default 0 = all cores)"}}};
 
@@ -42,7 +43,7 @@ int report_main(int argc, char** argv) {
   if (args.help()) return print_help(kReport);
   const std::string task = args.positional(0);
   if (!args.has("recipe")) require_known_task(task);  // with --recipe, TASK only names the files
-  CompositeRecipe r = CompositeRecipe::load(args.get("recipe", CompositeRecipe::default_file(task)));
+  CompositeRecipe r = CompositeRecipe::load(args.get("recipe", CompositeRecipe::default_file(task)), args.all("set"));
   const int threads = resolve_threads(args.get_int("threads", 0, Range::closed(0, kMaxThreads)));
   set_torch_threads(1);
   std::vector<std::string> wanted = args.has("methods") ? split(args.get("methods", "")) : method_names();
@@ -50,7 +51,9 @@ int report_main(int argc, char** argv) {
   auto methods = available_methods(r, wanted, /*skip_missing=*/!args.has("methods"), skipped);
   std::vector<MethodResult> results = measure_methods(r, methods, threads);
   std::string out = args.get("out", std::string(SEGUE_SOURCE_DIR) + "/experiments/results");
-  write_results(r, results, skipped, "segue report " + task, out);
+  std::string command = "segue report " + task;  // as the table records it
+  for (const std::string& set : args.all("set")) command += " --set " + set;
+  write_results(r, results, skipped, command, out);
   std::printf("wrote %s/%s.md and .json\n", out.c_str(), task.c_str());
   // The bar chart beside the paper's; a missing matplotlib costs the picture, not the table.
   if (run_plot_tool("methods '" + out + "/" + task + ".json'") != 0)
