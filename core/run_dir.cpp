@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cctype>
+#include <cmath>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -13,6 +14,7 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "core/distributed.h"
 #include "core/error.h"
 
 namespace fs = std::filesystem;
@@ -157,5 +159,29 @@ RunDir::RunDir(const std::string& dir, const std::string& resolved,
 }
 
 bool RunDir::has_checkpoint() const { return fs::exists(checkpoint()); }
+
+void require_same_recipe(const std::string& resolved, const std::string& file) {
+  const Distributed& group = Distributed::world();
+  if (group.single()) return;
+  const std::string diff = recipe_difference(group.broadcast(resolved), resolved, file);
+  const std::vector<std::string> all = group.gather(diff);
+  for (size_t r = 0; r < all.size(); ++r)
+    if (!all[r].empty())
+      throw Error(file + ": rank " + std::to_string(r) + " was started with another recipe than rank 0 (" + all[r] + ")");
+}
+
+std::string json_object(const std::vector<std::pair<std::string, double>>& fields) {
+  std::ostringstream o;
+  o.precision(10);
+  o << "{";
+  for (size_t i = 0; i < fields.size(); ++i) {
+    o << (i ? ", " : "") << "\"" << fields[i].first << "\": ";
+    const double v = fields[i].second;
+    if (!std::isfinite(v)) o << "null";
+    else o << v;
+  }
+  o << "}";
+  return o.str();
+}
 
 }  // namespace segue

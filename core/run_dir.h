@@ -28,6 +28,13 @@ class MetricsCsv {
 // The first key (in dotted form, `threads` aside) whose value differs between two resolved
 // recipes, as "key 'ppo.lr': A against B"; empty if they agree.
 std::string recipe_difference(const std::string& a, const std::string& b, const std::string& file);
+// With several ranks (Distributed::world()): every rank must run the same resolved recipe
+// as rank 0; a difference is refused on every rank, naming the first key that differs.
+void require_same_recipe(const std::string& resolved, const std::string& file);
+
+// {"k": v, ...} with numbers printed to full precision (integers without decimals), and
+// null for what is not finite.
+std::string json_object(const std::vector<std::pair<std::string, double>>& fields);
 
 class RunDir {
  public:

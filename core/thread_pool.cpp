@@ -2,6 +2,8 @@
 
 #include <cstdlib>
 
+#include <ATen/Parallel.h>
+
 #include <algorithm>
 
 namespace segue {
@@ -77,6 +79,15 @@ void ThreadPool::work(long seen) {
     }
     drain();
     busy_.fetch_sub(1, std::memory_order_release);
+  }
+}
+
+void set_torch_threads(int threads) {
+  at::set_num_threads(resolve_threads(threads));
+  static bool interop_set = false;  // may only be set once per process
+  if (!interop_set) {
+    at::set_num_interop_threads(1);
+    interop_set = true;
   }
 }
 

@@ -45,5 +45,7 @@ class ThreadPool {
 // kMaxThreads is refused where it is read (a typo must not start a million threads).
 constexpr int kMaxThreads = 1024;
 int resolve_threads(int requested);
+// Sets LibTorch's intra-op threads (0: every core) and its inter-op threads to one.
+void set_torch_threads(int threads);
 
 }  // namespace segue

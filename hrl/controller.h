@@ -3,6 +3,7 @@
 // switching between skills. One controller per environment slot, so a controller may
 // keep per-episode state (the current skill) and need not be thread-safe.
 #include <memory>
+#include <string>
 
 #include "algorithms/policy.h"
 #include "core/env.h"
@@ -16,6 +17,9 @@ class Controller {
   // a controller that draws random numbers of its own.
   virtual void reset(const Env& env, const float* obs, uint64_t seed) {}
   virtual void act(const Env& env, const float* obs, float* action) = 0;
+  // Who chose the last action, for a viewer: a skill's name, a transition policy
+  // ("walk->jump"), or "" for a single policy.
+  virtual std::string in_control() const { return ""; }
 };
 
 // One deterministic policy on the whole observation (a skill alone, or Single).

@@ -13,6 +13,7 @@
 #include "hrl/lee_transition.h"
 #include "hrl/results_table.h"
 #include "hrl/switch_training.h"
+#include "hrl/training_loop.h"
 #include "hrl/transition_env.h"
 #include "hrl/transition_policy.h"
 
@@ -22,15 +23,6 @@ namespace {
 namespace fs = std::filesystem;
 
 bool exists(const std::string& path) { return fs::exists(path); }
-
-// The signal number that asked the run to stop, or 0.
-int signal_of(const std::atomic<int>* stop) { return stop ? stop->load() : 0; }
-
-// Whether to stop, agreed by every rank (a collective): the signal number if any rank saw
-// one (1 where this rank did not), else 0.
-int agreed_stop(const Distributed& group, const std::atomic<int>* stop) {
-  return group.any(signal_of(stop) != 0) ? std::max(signal_of(stop), 1) : 0;
-}
 
 // Exports transition t's trained `file` (policy.pt, lee.pt, q.pt) into its folder, saying
 // what it is for (checked by load_transition_artefacts).
@@ -151,36 +143,25 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
   return 0;
 }
 
-// PPO iterations of `trainer` (a TransitionPolicyTrainer or LeeTrainer) to the budget,
-// with checkpoints; `row` turns an iteration's stats into its CSV row. Returns the signal
-// number when stopped, else 0.
-// With several ranks, rank 0 writes the CSV and reports; all stop at the same iteration.
+// PPO iterations of `trainer` (a TransitionPolicyTrainer or LeeTrainer) to the budget
+// (hrl/training_loop.h); `row` turns an iteration's stats into its CSV row. Returns the
+// signal number when stopped, else 0.
 template <class Trainer, class Row>
 int train_loop(Trainer& trainer, const CompositeRecipe& r, int64_t total_steps, const std::string& label,
                const std::string& ckpt, const std::string& csv_path, const std::vector<std::string>& columns,
                const PipelineOptions& o, Row row) {
-  const Distributed& group = *o.group;
-  std::optional<MetricsCsv> csv;
-  std::optional<Progress> progress;
-  if (group.leader()) {
-    csv.emplace(csv_path, columns, trainer.ppo().iteration());
-    progress.emplace(label, total_steps, trainer.ppo().global_step());
-  }
+  TrainingLoop loop{label, total_steps, 10, csv_path, columns, o.group, o.stop};
   double recent = NAN;
-  while (trainer.ppo().global_step() < total_steps) {
-    auto s = trainer.iterate();
-    if (s.ppo.episodes > 0) recent = s.ppo.success_rate;
-    if (csv) csv->write(row(s));
-    bool last = trainer.ppo().global_step() >= total_steps;
-    const int stop = agreed_stop(group, o.stop);
-    if (last || stop || s.ppo.iteration % 10 == 0) trainer.save(ckpt, r.resolved);
-    if (progress) progress->update(trainer.ppo().global_step(), s.ppo.episode_return, recent);
-    if (stop && !last) {
-      if (progress) progress->finish();
-      return stop;
-    }
-  }
-  if (progress) progress->finish();
+  const int stop = run_training_loop(
+      loop, trainer.ppo().iteration(), trainer.ppo().global_step(),
+      [&](std::vector<double>& out) {
+        const auto s = trainer.iterate();
+        out = row(s);
+        if (s.ppo.episodes > 0) recent = s.ppo.success_rate;
+        return s.ppo;
+      },
+      [&] { trainer.save(ckpt, r.resolved); });
+  if (stop) return stop;
   spdlog::info("  {}: {} steps in {}; success {:.0f}% in its last episodes", label, trainer.ppo().global_step(),
                format_duration(trainer.ppo().wall_seconds()), 100 * recent);
   return 0;

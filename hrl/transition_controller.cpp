@@ -94,4 +94,10 @@ void TransitionController::act(const Env& env, const float* obs, float* action) 
   if (rule_ == SwitchRule::TerminationHead && pi_ab.act_dim() > A && out_[A] > 0.0f) transition_ = -1;
 }
 
+std::string TransitionController::in_control() const {
+  if (transition_ < 0) return skills_[skill_].name;
+  const Transition& tr = meta_.transitions()[transition_];
+  return skills_[tr.from].name + "->" + skills_[tr.to].name;
+}
+
 }  // namespace segue

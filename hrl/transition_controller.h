@@ -55,6 +55,9 @@ class TransitionController : public Controller {
   void resume(const Env& env, int skill);
   void act(const Env& env, const float* obs, float* action) override;
   int skill() const { return skill_; }
+  // The skill's name, or "a->b" while transition a->b's pi_ab (or, at a random hand-over
+  // point, Without TP's pi_a) drives.
+  std::string in_control() const override;
   int transition() const { return transition_; }  // the transition pi_ab (or pi_a) drives, or -1
   // The transition whose interval the last act() entered (control passed to pi_ab, or
   // straight to pi_b), or -1.

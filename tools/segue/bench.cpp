@@ -18,6 +18,7 @@
 #include "core/rng.h"
 #include "core/thread_pool.h"
 #include "core/vector_env.h"
+#include "core/run_dir.h"
 #include "tools/segue/cli.h"
 
 namespace segue::cli {

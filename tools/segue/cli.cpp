@@ -115,16 +115,6 @@ void uninstall_stop_signals() {
   std::signal(SIGTERM, SIG_DFL);
 }
 
-void require_same_recipe(const std::string& resolved, const std::string& file) {
-  const Distributed& group = Distributed::world();
-  if (group.single()) return;
-  const std::string diff = recipe_difference(group.broadcast(resolved), resolved, file);
-  const std::vector<std::string> all = group.gather(diff);
-  for (size_t r = 0; r < all.size(); ++r)
-    if (!all[r].empty())
-      throw Error(file + ": rank " + std::to_string(r) + " was started with another recipe than rank 0 (" + all[r] + ")");
-}
-
 std::vector<std::string> close_names(const std::string& name, const std::vector<std::string>& known) {
   // The nearest by edit distance, if near enough; else the names holding it (or held by it).
   std::vector<std::string> out;
@@ -153,33 +143,6 @@ void require_known_task(const std::string& task) {
   if (!hint.empty()) hint += "?";
   for (const auto& n : known) all += (all.empty() ? "" : ", ") + n;
   throw Error("unknown task '" + task + "'" + hint + " (tasks: " + all + ")");
-}
-
-void set_torch_threads(int threads) {
-  at::set_num_threads(resolve_threads(threads));
-  static bool interop_set = false;  // may only be set once per process
-  if (!interop_set) {
-    at::set_num_interop_threads(1);
-    interop_set = true;
-  }
-}
-
-}  // namespace segue::cli
-
-namespace segue::cli {
-
-std::string json_object(const std::vector<std::pair<std::string, double>>& fields) {
-  std::ostringstream o;
-  o.precision(10);
-  o << "{";
-  for (size_t i = 0; i < fields.size(); ++i) {
-    o << (i ? ", " : "") << "\"" << fields[i].first << "\": ";
-    double v = fields[i].second;
-    if (!std::isfinite(v)) o << "null";
-    else o << v;
-  }
-  o << "}";
-  return o.str();
 }
 
 }  // namespace segue::cli

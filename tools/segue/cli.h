@@ -69,10 +69,6 @@ int run_plot_tool(const std::string& args);
 const std::atomic<int>& install_stop_signals();
 void uninstall_stop_signals();
 
-// With several ranks: every rank must run the same resolved recipe as rank 0; a
-// difference is refused on every rank, naming the first key that differs (`threads` may).
-void require_same_recipe(const std::string& resolved, const std::string& file);
-
 // The names in `known` a typo of `name` may have meant, at most three: those nearest by
 // edit distance where that is small, else those that contain it ("walker").
 std::vector<std::string> close_names(const std::string& name, const std::vector<std::string>& known);
@@ -80,12 +76,4 @@ std::vector<std::string> close_names(const std::string& name, const std::vector<
 // did you mean 'hurdle'? (tasks: ...)".
 void require_known_task(const std::string& task);
 
-// Sets LibTorch's intra-op threads; 0 means every core.
-void set_torch_threads(int threads);
-
-}  // namespace segue::cli
-
-namespace segue::cli {
-// {"k": v, ...} with numbers printed to full precision (integers without decimals).
-std::string json_object(const std::vector<std::pair<std::string, double>>& fields);
 }  // namespace segue::cli

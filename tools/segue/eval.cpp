@@ -6,6 +6,7 @@
 #include "core/thread_pool.h"
 #include "environments/registry.h"
 #include "hrl/composite_recipe.h"
+#include "core/run_dir.h"
 #include "tools/segue/cli.h"
 
 namespace segue::cli {

@@ -21,9 +21,13 @@
 #include <vector>
 
 #include "algorithms/policy.h"
-#include "hrl/skill_recipe.h"
 #include "core/mujoco_env.h"
+#include "core/run_dir.h"
+#include "core/thread_pool.h"
 #include "environments/registry.h"
+#include "hrl/composite_recipe.h"
+#include "hrl/controller.h"
+#include "hrl/skill_recipe.h"
 #include "tools/segue/cli.h"
 
 namespace segue::cli {
@@ -33,13 +37,18 @@ namespace fs = std::filesystem;
 
 const Command kRender{
     "render",
-    "POLICY-or-RECIPE --task NAME --out FILE.mp4 [--frames DIR] [--seed S] [--steps N] ...",
+    "[POLICY-or-RECIPE] --task NAME [--method M] --out FILE.mp4 [--frames DIR] [--seed S] ...",
     "Runs the deterministic policy (a checkpoint.pt, an exported .pt, or a recipe .yaml whose\n"
-    "run directory has a checkpoint.pt) for one episode and renders it headless (EGL). The\n"
-    "video is encoded by ffmpeg when it is on PATH; otherwise, or with --frames, PNG frames\n"
-    "are written instead (to FILE_frames/ or DIR).",
-    {"POLICY-or-RECIPE"},
+    "run directory has a checkpoint.pt) for one episode and renders it headless (EGL). With\n"
+    "--method and no POLICY, runs a method of the paper on a composite task with the recipe's\n"
+    "(by default the shipped) policies, the skill or transition in control written on each\n"
+    "frame and, per frame, in FILE_control.csv (or DIR/control.csv). The video is encoded by\n"
+    "ffmpeg when it is on PATH; otherwise, or with --frames, PNG frames are written instead\n"
+    "(to FILE_frames/ or DIR).",
+    {},
     {{"task", "NAME", "task to run (default: the recipe's task; required for a policy)"},
+     {"method", "M", "composite-task method (single, without-tp, tp, lee, tp+q)"},
+     {"recipe", "FILE", "with --method: composite recipe (default experiments/TASK.yaml)"},
      {"out", "FILE.mp4", "video to write"},
      {"frames", "DIR", "write PNG frames to DIR instead of a video"},
      {"seed", "S", "episode seed (default 0)"},
@@ -48,7 +57,8 @@ const Command kRender{
      {"height", "H", "frame height in pixels (default 480)"},
      {"fps", "F", "frames per second of simulated time (default 30)"},
      {"camera", "NAME", "model camera to use, or 'free' (default: 'track' if the model has it)"},
-     {"set", "key=value", "override a task setting, e.g. --set env.push_prob=0 (repeatable)", true}}};
+     {"set", "key=value", "override a task setting, e.g. --set env.push_prob=0 (repeatable)", true}},
+    1};
 
 std::string egl_error(const std::string& what) {
   char code[16];
@@ -151,11 +161,13 @@ class Renderer {
   Renderer(const Renderer&) = delete;
   Renderer& operator=(const Renderer&) = delete;
 
-  // Draws the current state into `rgb` (width*height*3 bytes, top row first).
-  void draw(mjData* d, std::vector<unsigned char>& rgb) {
+  // Draws the current state into `rgb` (width*height*3 bytes, top row first), `label` in
+  // its top-left corner.
+  void draw(mjData* d, std::vector<unsigned char>& rgb, const std::string& label = "") {
     mjrRect viewport{0, 0, width_, height_};
     mjv_updateScene(m_, d, &opt_, nullptr, &cam_, mjCAT_ALL, &scn_);
     mjr_render(viewport, &scn_, &con_);
+    if (!label.empty()) mjr_overlay(mjFONT_BIG, mjGRID_TOPLEFT, viewport, label.c_str(), nullptr, &con_);
     mjr_readPixels(rows_.data(), nullptr, viewport, &con_);
     // OpenGL returns the bottom row first; images and video want the top row first.
     const size_t stride = size_t(3) * width_;
@@ -288,7 +300,6 @@ class FfmpegPipe {
 int render_main(int argc, char** argv) {
   Args args(kRender, argc, argv);
   if (args.help()) return print_help(kRender);
-  const std::string source = args.positional(0);
   if (!args.has("out") && !args.has("frames"))
     throw Error("segue render: --out FILE.mp4 or --frames DIR is required (see segue render --help)");
   if (args.has("task")) require_known_task(args.get("task", ""));
@@ -297,32 +308,58 @@ int render_main(int argc, char** argv) {
             height = args.get_int("height", 480, Range::closed(16, 8192)),
             fps = args.get_int("fps", 30, Range::closed(1, 1000));
 
-  // The task's environment and the policy: from a recipe's run directory or a policy file.
-  std::string task, policy_path = source;
+  // The task's environment and what acts in it: a method on a composite task, or a policy
+  // from a recipe's run directory or a file.
+  std::string task;
   std::function<std::unique_ptr<Env>()> make;
-  if (fs::path(source).extension() == ".yaml") {
-    Recipe recipe = Recipe::load(source, args.all("set"));
-    SkillRecipe s = SkillRecipe::read(recipe, "runs/" + fs::path(source).stem().string());
-    task = args.get("task", s.task);
-    make = task == s.task ? s.make_env : task_factory(task, recipe.root().sub("env"));
-    recipe.reject_unknown();
-    policy_path = (fs::path(s.run_dir) / "checkpoint.pt").string();
-    if (!fs::exists(policy_path))
-      throw Error("segue render: " + source + ": no checkpoint at " + policy_path + " (train it first)");
-  } else {
-    if (!args.has("task")) throw Error("segue render: --task NAME is required (see segue render --help)");
+  std::unique_ptr<Controller> controller;
+  CompositeRecipe composite;  // with --method: the controllers refer to it
+  const bool by_method = args.has("method");
+  if (by_method) {
+    if (args.positional_count() > 0) throw Error("segue render: give a POLICY or --method, not both");
+    if (!args.has("task")) throw Error("segue render: --method needs --task NAME (a composite task)");
     task = args.get("task", "");
-    Recipe settings = Recipe::parse("{}", "--set", args.all("set"));
-    make = task_factory(task, settings.root().sub("env"));
-    settings.reject_unknown();
+    const std::string file = args.get("recipe", CompositeRecipe::default_file(task));
+    if (!args.has("recipe") && !fs::exists(file))
+      throw Error("segue render: task '" + task + "' has no composite recipe (experiments/" + task +
+                  ".yaml); --method is for composite tasks (or give --recipe FILE)");
+    composite = CompositeRecipe::load(file, args.all("set"));
+    if (composite.task != task)
+      throw Error(composite.file + ": key 'task' is '" + composite.task + "', not '" + task + "'");
+    make = composite.make_env;
+    controller = method_controllers(composite, args.get("method", ""))();
+  } else if (args.positional_count() == 0) {
+    throw Error("segue render: give a POLICY (or a recipe), or --method for a composite task");
+  } else if (args.has("recipe")) {
+    throw Error("segue render: --recipe goes with --method");
+  } else {
+    const std::string source = args.positional(0);
+    std::string policy_path = source;
+    if (fs::path(source).extension() == ".yaml") {
+      Recipe recipe = Recipe::load(source, args.all("set"));
+      SkillRecipe s = SkillRecipe::read(recipe, "runs/" + fs::path(source).stem().string());
+      task = args.get("task", s.task);
+      make = task == s.task ? s.make_env : task_factory(task, recipe.root().sub("env"));
+      recipe.reject_unknown();
+      policy_path = (fs::path(s.run_dir) / "checkpoint.pt").string();
+      if (!fs::exists(policy_path))
+        throw Error("segue render: " + source + ": no checkpoint at " + policy_path + " (train it first)");
+    } else {
+      if (!args.has("task")) throw Error("segue render: --task NAME is required (see segue render --help)");
+      task = args.get("task", "");
+      Recipe settings = Recipe::parse("{}", "--set", args.all("set"));
+      make = task_factory(task, settings.root().sub("env"));
+      settings.reject_unknown();
+    }
+    Policy policy = Policy::load(policy_path);
+    policy.check_fits(make()->spec(), policy_path);
+    controller = std::make_unique<PolicyController>(policy);
   }
   std::unique_ptr<Env> env = make();
   auto* mj = dynamic_cast<MujocoEnv*>(env.get());
   if (!mj) throw Error("segue render: task '" + task + "' is not a MuJoCo environment");
   const EnvSpec& spec = env->spec();
   set_torch_threads(1);
-  Policy policy = Policy::load(policy_path);
-  policy.check_fits(spec, policy_path);
   const int steps = args.get_int("steps", spec.max_episode_steps, Range::positive());
 
   // Where frames go: ffmpeg when asked for a video and available, else PNG files.
@@ -351,9 +388,13 @@ int render_main(int argc, char** argv) {
   std::vector<unsigned char> rgb;
   int frames = 0;
   double next_frame = 0.0;  // simulated time of the next frame, so the video plays in real time
+  // With --method: who is in control at each frame (frame, step, in_control).
+  std::string control = "frame,step,in_control\n";
   auto capture = [&](int step) {
     if (step * mj->control_dt() + 1e-9 < next_frame) return;
-    renderer.draw(mj->mutable_data(), rgb);
+    const std::string label = by_method ? controller->in_control() : "";
+    renderer.draw(mj->mutable_data(), rgb, label);
+    if (by_method) control += std::to_string(frames) + "," + std::to_string(step) + "," + label + "\n";
     if (pipe) {
       pipe->write(rgb);
     } else {
@@ -366,20 +407,37 @@ int render_main(int argc, char** argv) {
   };
 
   env->reset(uint64_t(seed), obs.data());
-  capture(0);
-  double ret = 0.0;
+  controller->reset(*env, obs.data(), uint64_t(seed));
+  // The first frame shows the state before any action: who will act on it is known once
+  // the controller has chosen, so each frame is labelled by the action taken from it.
+  double ret = 0.0, successes = 0.0;
   bool success = false;
+  controller->act(*env, obs.data(), action.data());
+  capture(0);
   for (int t = 1; t <= steps; ++t) {
-    policy.act(obs.data(), 1, action.data());
     StepResult r = env->step(action.data(), obs.data());
     ret += r.reward;
     success = r.info.success;
+    successes = r.info.success_count;
+    if (r.done() || t == steps) {
+      capture(t);
+      break;
+    }
+    controller->act(*env, obs.data(), action.data());
     capture(t);
-    if (r.done()) break;
   }
   if (pipe) pipe->close();
-  std::printf("wrote %s (%d frames, episode return %.2f, success %s)\n",
-              video ? out.c_str() : frames_dir.c_str(), frames, ret, success ? "yes" : "no");
+  if (by_method) {
+    const fs::path file = video ? fs::path(fs::path(out).replace_extension().string() + "_control.csv")
+                                : frames_dir / "control.csv";
+    write_file_atomic(file.string(), control);
+  }
+  if (by_method)
+    std::printf("wrote %s (%d frames, episode return %.2f, success count %g)\n",
+                video ? out.c_str() : frames_dir.c_str(), frames, ret, successes);
+  else
+    std::printf("wrote %s (%d frames, episode return %.2f, success %s)\n",
+                video ? out.c_str() : frames_dir.c_str(), frames, ret, success ? "yes" : "no");
   return 0;
 }
 

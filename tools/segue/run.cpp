@@ -5,6 +5,8 @@
 
 #include "core/distributed.h"
 #include "hrl/pipeline.h"
+#include "core/run_dir.h"
+#include "core/thread_pool.h"
 #include "tools/segue/cli.h"
 
 namespace segue::cli {
