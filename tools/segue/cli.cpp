@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 
 #include "core/distributed.h"
@@ -143,6 +144,17 @@ void require_known_task(const std::string& task) {
   if (!hint.empty()) hint += "?";
   for (const auto& n : known) all += (all.empty() ? "" : ", ") + n;
   throw Error("unknown task '" + task + "'" + hint + " (tasks: " + all + ")");
+}
+
+CompositeRecipe method_recipe(const std::string& command, const Args& args, const std::string& task,
+                              const std::vector<std::string>& sets) {
+  const std::string file = args.get("recipe", CompositeRecipe::default_file(task));
+  if (!args.has("recipe") && !std::filesystem::exists(file))
+    throw Error("segue " + command + ": task '" + task + "' has no composite recipe (experiments/" + task +
+                ".yaml); --method is for composite tasks (or give --recipe FILE)");
+  CompositeRecipe r = CompositeRecipe::load(file, sets);
+  if (r.task != task) throw Error(r.file + ": key 'task' is '" + r.task + "', not '" + task + "'");
+  return r;
 }
 
 }  // namespace segue::cli

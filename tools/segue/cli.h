@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "core/recipe.h"
 #include "core/thread_pool.h"
+#include "hrl/composite_recipe.h"
 
 namespace segue::cli {
 
@@ -75,5 +76,11 @@ std::vector<std::string> close_names(const std::string& name, const std::vector<
 // Refuses a task name the registry does not know, in one line: "unknown task 'hurdel';
 // did you mean 'hurdle'? (tasks: ...)".
 void require_known_task(const std::string& task);
+
+// The composite recipe a command's --method runs on `task`: --recipe FILE, else the shipped
+// experiments/TASK.yaml, with `sets` laid over it. Refused in one line (naming `command`)
+// where the task has no such recipe or the file is another task's.
+CompositeRecipe method_recipe(const std::string& command, const Args& args, const std::string& task,
+                              const std::vector<std::string>& sets);
 
 }  // namespace segue::cli

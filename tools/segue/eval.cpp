@@ -54,13 +54,7 @@ int eval_main(int argc, char** argv) {
       if (method != "single") throw Error("segue eval: a POLICY argument only goes with --method single");
       sets.push_back("methods.single.policy=" + args.positional(0));
     }
-    const std::string file = args.get("recipe", CompositeRecipe::default_file(task));
-    if (!args.has("recipe") && !std::filesystem::exists(file))
-      throw Error("segue eval: task '" + task + "' has no composite recipe (experiments/" + task +
-                  ".yaml); --method is for composite tasks (or give --recipe FILE)");
-    composite = CompositeRecipe::load(file, sets);
-    if (composite.task != task)
-      throw Error(composite.file + ": key 'task' is '" + composite.task + "', not '" + task + "'");
+    composite = method_recipe("eval", args, task, sets);
     make = composite.make_env;
     controllers = method_controllers(composite, method);
     label = method;

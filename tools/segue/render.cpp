@@ -319,13 +319,7 @@ int render_main(int argc, char** argv) {
     if (args.positional_count() > 0) throw Error("segue render: give a POLICY or --method, not both");
     if (!args.has("task")) throw Error("segue render: --method needs --task NAME (a composite task)");
     task = args.get("task", "");
-    const std::string file = args.get("recipe", CompositeRecipe::default_file(task));
-    if (!args.has("recipe") && !fs::exists(file))
-      throw Error("segue render: task '" + task + "' has no composite recipe (experiments/" + task +
-                  ".yaml); --method is for composite tasks (or give --recipe FILE)");
-    composite = CompositeRecipe::load(file, args.all("set"));
-    if (composite.task != task)
-      throw Error(composite.file + ": key 'task' is '" + composite.task + "', not '" + task + "'");
+    composite = method_recipe("render", args, task, args.all("set"));
     make = composite.make_env;
     controller = method_controllers(composite, args.get("method", ""))();
   } else if (args.positional_count() == 0) {
