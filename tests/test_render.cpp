@@ -26,12 +26,8 @@ class Render : public TempDirTest {
 TEST_F(Render, AMethodsFramesNameWhoIsInControl) {
   // Tiny Patrol with forward->balance's interval at steps 20 to 120 of the episode: Without
   // TP hands over to balance as it begins.
-  std::string text = kTinyPatrol;
-  const std::string interval = "when: {since_turn: [0, 100]}";
-  ASSERT_NE(text.find(interval), std::string::npos);
-  text.replace(text.find(interval), interval.size(), "when: {steps: [20, 120]}");
   const std::string file = path("tiny.yaml");
-  std::ofstream(file) << text;
+  std::ofstream(file) << tiny_patrol_by_steps();
   const int steps = 60;
   uint64_t seed = 0;
   CompositeRecipe r = CompositeRecipe::load(file, {"run_dir=" + path("run")});

@@ -117,11 +117,7 @@ TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
 // and then as pi_b, action for action. Over the episodes the points spread over the whole
 // interval, and the same episode seed draws the same point.
 TEST_F(TransitionTraining, ARandomHandOverPointIsDrawnUniformlyOverTheInterval) {
-  std::string text = kTinyPatrol;
-  const std::string interval = "when: {since_turn: [0, 100]}";
-  ASSERT_NE(text.find(interval), std::string::npos);
-  text.replace(text.find(interval), interval.size(), "when: {steps: [20, 120]}");
-  std::ofstream(path("by_steps.yaml")) << text;
+  std::ofstream(path("by_steps.yaml")) << tiny_patrol_by_steps();
   CompositeRecipe r = CompositeRecipe::load(path("by_steps.yaml"), {"eval.handover_point=random", "run_dir=" + path("run")});
   ASSERT_EQ(r.handover_point, HandOverPoint::Random);
   const Transition& tr = r.meta.transitions()[0];

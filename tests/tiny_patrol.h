@@ -1,6 +1,8 @@
 #pragma once
 // A composite recipe small enough for tests: Patrol cut to one transition (forward ->
 // balance), 300-step episodes, no pushes, budgets of a few seconds.
+#include <string>
+
 namespace segue {
 
 inline constexpr const char* kTinyPatrol = R"(
@@ -24,5 +26,14 @@ transition:
 switch: {attempts: 24, warmup: 16, batch: 16, updates_per_attempt: 2}
 eval: {episodes: 3, seeds: [0]}
 )";
+
+// The tiny recipe with forward->balance's interval at steps 20 to 120 of the episode,
+// which every episode that starts walking forward reaches.
+inline std::string tiny_patrol_by_steps() {
+  std::string text = kTinyPatrol;
+  const std::string interval = "when: {since_turn: [0, 100]}";
+  text.replace(text.find(interval), interval.size(), "when: {steps: [20, 120]}");
+  return text;
+}
 
 }  // namespace segue

@@ -313,6 +313,7 @@ int render_main(int argc, char** argv) {
   std::string task;
   std::function<std::unique_ptr<Env>()> make;
   std::unique_ptr<Controller> controller;
+  std::string policy_path;    // without --method: the policy, loaded once the env is made
   CompositeRecipe composite;  // with --method: the controllers refer to it
   const bool by_method = args.has("method");
   if (by_method) {
@@ -328,7 +329,7 @@ int render_main(int argc, char** argv) {
     throw Error("segue render: --recipe goes with --method");
   } else {
     const std::string source = args.positional(0);
-    std::string policy_path = source;
+    policy_path = source;
     if (fs::path(source).extension() == ".yaml") {
       Recipe recipe = Recipe::load(source, args.all("set"));
       SkillRecipe s = SkillRecipe::read(recipe, "runs/" + fs::path(source).stem().string());
@@ -345,15 +346,17 @@ int render_main(int argc, char** argv) {
       make = task_factory(task, settings.root().sub("env"));
       settings.reject_unknown();
     }
-    Policy policy = Policy::load(policy_path);
-    policy.check_fits(make()->spec(), policy_path);
-    controller = std::make_unique<PolicyController>(policy);
   }
   std::unique_ptr<Env> env = make();
   auto* mj = dynamic_cast<MujocoEnv*>(env.get());
   if (!mj) throw Error("segue render: task '" + task + "' is not a MuJoCo environment");
   const EnvSpec& spec = env->spec();
   set_torch_threads(1);
+  if (!by_method) {
+    Policy policy = Policy::load(policy_path);
+    policy.check_fits(spec, policy_path);
+    controller = std::make_unique<PolicyController>(policy);
+  }
   const int steps = args.get_int("steps", spec.max_episode_steps, Range::positive());
 
   // Where frames go: ffmpeg when asked for a video and available, else PNG files.
