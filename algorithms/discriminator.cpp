@@ -3,8 +3,8 @@
 namespace segue {
 
 DiscriminatorImpl::DiscriminatorImpl(const DiscriminatorSpec& s) : spec(s) {
-  g = register_module("g", make_mlp(s.state_dim() + s.act_dim, s.hidden, 1, Activation::Relu, 1.0));
-  h = register_module("h", make_mlp(s.state_dim(), s.hidden, 1, Activation::Relu, 1.0));
+  g = register_module("g", make_mlp(s.obs_dim + s.act_dim, s.hidden, 1, Activation::Relu, 1.0));
+  h = register_module("h", make_mlp(s.obs_dim, s.hidden, 1, Activation::Relu, 1.0));
   obs_mean = register_buffer("obs_mean", torch::zeros({s.obs_dim}));
   obs_std = register_buffer("obs_std", torch::ones({s.obs_dim}));
   act_mean = register_buffer("act_mean", torch::zeros({s.act_dim}));
@@ -21,18 +21,7 @@ void DiscriminatorImpl::set_normalizer(const torch::Tensor& om, const torch::Ten
 }
 
 torch::Tensor DiscriminatorImpl::state_input(const torch::Tensor& o) const {
-  auto s = ((o - obs_mean) / obs_std).clamp(-5.0, 5.0);
-  if (spec.features.empty()) return s;
-  // The order of ObsFeatures::write: per input, per period, sin then cos.
-  constexpr double kTwoPi = 6.283185307179586476925;
-  std::vector<torch::Tensor> cols{s};
-  for (int i : spec.features.inputs)
-    for (double p : spec.features.periods) {
-      auto phase = o.select(-1, i).unsqueeze(-1) * (kTwoPi / p);
-      cols.push_back(torch::sin(phase));
-      cols.push_back(torch::cos(phase));
-    }
-  return torch::cat(cols, -1);
+  return ((o - obs_mean) / obs_std).clamp(-5.0, 5.0);
 }
 
 torch::Tensor DiscriminatorImpl::f(const torch::Tensor& obs, const torch::Tensor& act, const torch::Tensor& next_obs,
@@ -60,16 +49,6 @@ torch::Tensor DiscriminatorImpl::loss(const torch::Tensor& expert_logit, const t
   auto expert = torch::nn::functional::softplus(-expert_logit).mean();
   auto generator = torch::nn::functional::softplus(generator_logit).mean();
   return 0.5 * (expert + generator);
-}
-
-torch::Tensor DiscriminatorImpl::gradient_penalty(const torch::Tensor& obs, const torch::Tensor& act,
-                                                 const torch::Tensor& next_obs, const torch::Tensor& done) {
-  auto s = obs.detach().requires_grad_(true), a = act.detach().requires_grad_(true),
-       s2 = next_obs.detach().requires_grad_(true);
-  // f is a sum over rows of per-row functions, so the gradient of the sum holds each row's.
-  auto grads = torch::autograd::grad({f(s, a, s2, done).sum()}, {s, a, s2}, {}, /*retain_graph=*/true,
-                                     /*create_graph=*/true);
-  return (grads[0].pow(2).sum(-1) + grads[1].pow(2).sum(-1) + grads[2].pow(2).sum(-1)).mean();
 }
 
 }  // namespace segue

@@ -5,12 +5,10 @@
 // trained by logistic regression: expert transitions (pi_b's, label 1) against the
 // generator's (pi_ab's, label 0). The logit of D is f - log pi(a|s), so
 //   Discriminator::reward = log D - log(1 - D) = f - log pi(a|s)      (Eq. 3)
-// Inputs are normalised with the expert data's mean and std, clipped to +-5 (reference),
-// optionally followed by periodic features of raw inputs (algorithms/obs_features.h).
+// Inputs are normalised with the expert data's mean and std, clipped to +-5 (reference).
 #include <torch/torch.h>
 
 #include "algorithms/mlp.h"
-#include "algorithms/obs_features.h"
 
 namespace segue {
 
@@ -18,10 +16,6 @@ struct DiscriminatorSpec {
   int obs_dim = 0, act_dim = 0;
   std::vector<int> hidden{100, 100};  // g and h: 2 x 100 ReLU each, the reference's (docs/reference/learners.md)
   double gamma = 0.99;
-  // Periodic features of s appended to g's and h's state input, so D can tell states by
-  // their phase, e.g. where a gait meets a curb (what pi_b's own features let it see).
-  ObsFeatures features;
-  int state_dim() const { return obs_dim + features.size(); }
 };
 
 class DiscriminatorImpl : public torch::nn::Module {
@@ -38,14 +32,6 @@ class DiscriminatorImpl : public torch::nn::Module {
                        const torch::Tensor& done, const torch::Tensor& log_pi);
   // Binary cross-entropy of D: expert labelled 1, generator 0 (mean over both batches).
   torch::Tensor loss(const torch::Tensor& expert_logit, const torch::Tensor& generator_logit) const;
-  // The R1 penalty (Mescheder et al. 2018) on expert transitions: E ||grad_(s, a, s') f||^2,
-  // with the graph kept so that it can be minimised. Not in the paper (recipe key
-  // `transition.discriminator.gradient_penalty`, off by default): it keeps f smooth around
-  // T_b, so that once D tells the two apart, Eq. 3 still grades how near pi_ab's
-  // transitions are rather than only saturating.
-  torch::Tensor gradient_penalty(const torch::Tensor& obs, const torch::Tensor& act, const torch::Tensor& next_obs,
-                                 const torch::Tensor& done);
-
   // Fixes the input normalisation from the expert data (mean, std of s and a).
   void set_normalizer(const torch::Tensor& obs_mean, const torch::Tensor& obs_std,
                       const torch::Tensor& act_mean, const torch::Tensor& act_std);
@@ -55,7 +41,7 @@ class DiscriminatorImpl : public torch::nn::Module {
   torch::Tensor obs_mean, obs_std, act_mean, act_std;  // buffers
 
  private:
-  // s's input to g and h: normalised s, then its periodic features.
+  // s's input to g and h: s normalised.
   torch::Tensor state_input(const torch::Tensor& o) const;
 };
 TORCH_MODULE(Discriminator);

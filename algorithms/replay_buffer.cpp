@@ -7,16 +7,19 @@
 namespace segue {
 
 ReplayBuffer::ReplayBuffer(int64_t capacity, int obs_dim, int act_dim)
-    : capacity_(capacity), obs_dim_(obs_dim), act_dim_(act_dim) {
-  obs_.resize(size_t(capacity) * obs_dim);
-  next_obs_.resize(size_t(capacity) * obs_dim);
-  act_.resize(size_t(capacity) * act_dim);
-  reward_.resize(capacity);
-  terminal_.resize(capacity);
+    : capacity_(capacity), obs_dim_(obs_dim), act_dim_(act_dim) {}
+
+void ReplayBuffer::resize(int64_t rows) {
+  obs_.resize(size_t(rows) * obs_dim_);
+  next_obs_.resize(size_t(rows) * obs_dim_);
+  act_.resize(size_t(rows) * act_dim_);
+  reward_.resize(size_t(rows));
+  terminal_.resize(size_t(rows));
 }
 
 void ReplayBuffer::add(const float* obs, const float* act, double reward, const float* next_obs, bool terminal) {
   const size_t k = size_t(next_);
+  if (size_ < capacity_) resize(size_ + 1);  // amortised: std::vector grows geometrically
   std::copy(obs, obs + obs_dim_, &obs_[k * obs_dim_]);
   std::copy(next_obs, next_obs + obs_dim_, &next_obs_[k * obs_dim_]);
   std::copy(act, act + act_dim_, &act_[k * act_dim_]);
@@ -65,8 +68,9 @@ void ReplayBuffer::load(torch::serialize::InputArchive& ar) {
   torch::Tensor c, o, n, a, r, t;
   ar.read("replay_counters", c);
   if (c[0].item<int64_t>() != capacity_ || c[3].item<int64_t>() != obs_dim_ || c[4].item<int64_t>() != act_dim_)
-    throw Error("the checkpoint's replay buffer has another capacity or shape than the recipe's (sac.buffer_size)");
+    throw Error("the checkpoint's replay buffer has another capacity or row width than the recipe's");
   size_ = c[1].item<int64_t>(), next_ = c[2].item<int64_t>();
+  resize(size_);
   ar.read("replay_obs", o), ar.read("replay_next_obs", n), ar.read("replay_act", a);
   ar.read("replay_reward", r), ar.read("replay_terminal", t);
   restore(obs_, o), restore(next_obs_, n), restore(act_, a), restore(reward_, r), restore(terminal_, t);

@@ -345,7 +345,11 @@ void SAC::load_checkpoint(const std::string& path, bool resume) {
     read_optimizer(ar, "actor_optimizer", *actor_opt_);
     read_optimizer(ar, "q_optimizer", *q_opt_);
     read_optimizer(ar, "alpha_optimizer", *alpha_opt_);
-    replay_.load(ar);
+    try {
+      replay_.load(ar);
+    } catch (const Error& e) {
+      throw Error(std::string(e.what()) + " (sac.buffer_size)");
+    }
     ar.read("meta_counters", counters);
     iteration_ = counters[0].item<int64_t>(), global_step_ = counters[1].item<int64_t>();
     wall_seconds_ = counters[2].item<int64_t>() / 1000.0;

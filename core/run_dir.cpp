@@ -130,6 +130,35 @@ std::string recipe_difference(const std::string& a, const std::string& b, const 
   return "";
 }
 
+namespace {
+// Settings Segue no longer has, each with the value at which it left the computation alone.
+// A run directory started before one was dropped records it: the run resumes where it had
+// that value (the code computes what it did), and is refused, naming the key, where not.
+const std::map<std::string, std::string>& retired_keys() {
+  static const std::map<std::string, std::string> keys{
+      {"ppo.noise_repeat", "1"}, {"trpo.noise_repeat", "1"}, {"transition.ppo.noise_repeat", "1"},
+      {"switch.ensemble", "1"}, {"switch.interval_features", "false"},
+      {"transition.discriminator.gradient_penalty", "0"},
+      {"env.ghost_curbs", "false"}, {"env.ghost_depth_cost", "0"}, {"env.takeoff_bonus", "0"},
+      {"env.close_stance_cost", "0"}, {"env.stance_height", "0.08"}, {"env.placement_bonus", "0"},
+      {"env.placement_target", "-0.8"}, {"env.placement_width", "0.3"}, {"env.approach_speed", "0"},
+      {"env.approach_from", "3"}, {"env.approach_to", "1.5"}, {"env.clearance_weight", "0"},
+      {"env.clearance_before", "0.3"}, {"env.peak_weight", "0"}, {"env.center_weight", "0"},
+      {"env.push_weight", "0"}};
+  return keys;
+}
+
+bool same_value(const std::string& a, const std::string& b) {
+  try {
+    size_t na = 0, nb = 0;
+    const double x = std::stod(a, &na), y = std::stod(b, &nb);
+    if (na == a.size() && nb == b.size()) return x == y;
+  } catch (const std::exception&) {
+  }
+  return a == b;
+}
+}  // namespace
+
 RunDir::RunDir(const std::string& dir, const std::string& resolved,
                const std::set<std::string>& defaulted)
     : dir_(dir) {
@@ -144,18 +173,27 @@ RunDir::RunDir(const std::string& dir, const std::string& resolved,
     return Error(recipe + ": this run directory was started with a different recipe (key '" + key +
                  "': " + was + " there, " + is + " now); choose another run_dir or remove the directory");
   };
+  bool changed = false;
   for (const auto& [key, value] : then) {
     auto it = now.find(key);
-    if (it == now.end()) throw refuse(key, value, "absent");
+    if (it == now.end()) {
+      const auto retired = retired_keys().find(key);
+      if (retired == retired_keys().end()) throw refuse(key, value, "absent");
+      if (!same_value(value, retired->second))
+        throw Error(recipe + ": this run directory was started with key '" + key + "': " + value +
+                    ", a setting Segue no longer has (only runs at " + retired->second +
+                    " resume); choose another run_dir or remove the directory");
+      changed = true;  // dropped from the recorded recipe
+      continue;
+    }
     if (it->second != value) throw refuse(key, value, it->second);
   }
-  bool added = false;
   for (const auto& [key, value] : now)
     if (!then.count(key)) {
       if (!defaulted.count(key)) throw refuse(key, "absent", value);
-      added = true;
+      changed = true;
     }
-  if (added) write_file_atomic(recipe, resolved);
+  if (changed) write_file_atomic(recipe, resolved);
 }
 
 bool RunDir::has_checkpoint() const { return fs::exists(checkpoint()); }

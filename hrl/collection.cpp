@@ -52,7 +52,7 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
   };
   std::vector<Worker> workers(size_t(std::max(1, threads)));
   for (auto& w : workers) {
-    w.env = r.training_envs.at(transition)();
+    w.env = r.training.at(transition).env();
     w.controller.emplace(r.skills, r.meta, trained, any_q ? SwitchRule::QNetwork : SwitchRule::IntervalEnd);
     w.obs.resize(w.env->spec().obs_dim), w.act.resize(w.env->spec().act_dim);
   }
@@ -103,7 +103,8 @@ StartStates collect_start_states(const CompositeRecipe& r, int transition, int c
 Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, int count, uint64_t seed,
                                       int max_episodes, const std::atomic<int>* stop, const StartStates* handovers,
                                       int threads) {
-  const Transition& tr = r.meta.transitions().at(transition);
+  const Transition& rule = r.meta.transitions().at(transition);
+  const TransitionTrainingSpec& tr = r.training.at(transition);
   const bool own_task = !tr.expert_task.empty();
   if (tr.expert_after_handover) {
     if (!handovers || handovers->size() == 0)
@@ -111,7 +112,7 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
                   ": expert.after_handover needs S_a's states, and none were given");
     max_episodes = handovers->size();  // restores are exact and pi_b deterministic: once each
   }
-  Skill b = r.skills[tr.to];
+  Skill b = r.skills[rule.to];
   const int D = b.obs_end - b.obs_begin;
   // On its own sub-task (checked at load to have D numbers) pi_b sees all of them.
   if (own_task) {
@@ -126,7 +127,7 @@ Demonstrations collect_demonstrations(const CompositeRecipe& r, int transition, 
   };
   std::vector<Worker> workers(size_t(std::max(1, threads)));
   for (auto& w : workers) {
-    w.env = own_task ? reference_task_factory(tr.expert_task)() : r.training_envs.at(transition)();
+    w.env = own_task ? reference_task_factory(tr.expert_task)() : tr.env();
     w.b = b;
     w.obs.resize(w.env->spec().obs_dim), w.act.resize(w.env->spec().act_dim), w.prev.resize(D);
     w.f.resize(w.env->spec().feature_names.size());

@@ -20,42 +20,44 @@ CompositeRecipe CompositeRecipe::load(const std::string& file, const std::vector
   c.task = root.require<std::string>("task");
   c.make_env = read_task(root, c.task, c.spec);
   c.skills = read_skills(root.sub("skills"), c.spec);
-  c.meta = MetaController(root, c.skills, c.spec.feature_names,
-                          [](const std::string& task) { return reference_task_factory(task)()->spec().feature_names; });
+  c.meta = MetaController(root, c.skills, c.spec.feature_names);
   const auto items = root.items("transitions");
   for (size_t t = 0; t < c.meta.transitions().size(); ++t) {
+    const Transition& rule = c.meta.transitions()[t];
+    TransitionTrainingSpec spec = TransitionTrainingSpec::read(
+        items[t], rule, c.spec.feature_names,
+        [](const std::string& task) { return reference_task_factory(task)()->spec().feature_names; });
     Section training = items[t].sub("training");
-    if (!training.has("env")) {
-      c.training_envs.push_back(c.make_env);
-      continue;
+    if (training.has("env")) {
+      training.sub("env").filled_from(root.sub("env"));
+      EnvSpec own;
+      spec.env = read_task(training, c.task, own);
+      if (own.obs_dim != c.spec.obs_dim || own.act_dim != c.spec.act_dim || own.feature_names != c.spec.feature_names)
+        throw training.error("env", "changes the task's observations, actions or features; it may change only how "
+                                    "episodes run (pushes, noise, rules)");
+    } else {
+      spec.env = c.make_env;
     }
-    training.sub("env").filled_from(root.sub("env"));
-    EnvSpec spec;
-    c.training_envs.push_back(read_task(training, c.task, spec));
-    if (spec.obs_dim != c.spec.obs_dim || spec.act_dim != c.spec.act_dim || spec.feature_names != c.spec.feature_names)
-      throw training.error("env", "changes the task's observations, actions or features; it may change only how "
-                                  "episodes run (pushes, noise, rules)");
-  }
-  for (size_t t = 0; t < c.meta.transitions().size(); ++t) {
-    const Transition& tr = c.meta.transitions()[t];
-    if (tr.expert_task.empty()) continue;
-    Section e = items[t].sub("expert");
-    std::unique_ptr<Env> own;
-    try {
-      own = reference_task_factory(tr.expert_task)();
-    } catch (const Error& err) {
-      throw e.error("task", err.what());
+    if (!spec.expert_task.empty()) {  // pi_b's own task must give it the numbers it sees here
+      Section e = items[t].sub("expert");
+      std::unique_ptr<Env> own;
+      try {
+        own = reference_task_factory(spec.expert_task)();
+      } catch (const Error& err) {
+        throw e.error("task", err.what());
+      }
+      const Skill& b = c.skills[rule.to];
+      if (own->spec().obs_dim != b.obs_end - b.obs_begin)
+        throw e.error("task", "'" + spec.expert_task + "' has obs_dim " + std::to_string(own->spec().obs_dim) +
+                                  ", but skill '" + b.name + "' sees " + std::to_string(b.obs_end - b.obs_begin) +
+                                  " numbers of this task");
     }
-    const Skill& b = c.skills[tr.to];
-    if (own->spec().obs_dim != b.obs_end - b.obs_begin)
-      throw e.error("task", "'" + tr.expert_task + "' has obs_dim " + std::to_string(own->spec().obs_dim) +
-                                ", but skill '" + b.name + "' sees " + std::to_string(b.obs_end - b.obs_begin) +
-                                " numbers of this task");
+    c.training.push_back(spec);
   }
   Section methods = root.sub("methods");
   if (methods.has("single")) c.single_policy = methods.sub("single").require<std::string>("policy");
   c.transitions_dir = methods.get<std::string>("transitions", "");
-  c.pipeline = PipelineConfig::read(root, c.task, c.spec.obs_dim);
+  c.pipeline = PipelineConfig::read(root, c.task);
   if (c.pipeline.transition.init_from_next)  // pi_ab starts as a copy of pi_b: the same layers
     for (const Transition& tr : c.meta.transitions()) {
       const Skill& b = c.skills[tr.to];
@@ -94,7 +96,7 @@ std::string CompositeRecipe::transition_name(int t) const {
 std::string CompositeRecipe::transition_source(int t) const { return spec.name + " " + transition_name(t); }
 
 int CompositeRecipe::start_state_count(int t) const {
-  const int own = meta.transitions().at(t).start_states;
+  const int own = training.at(t).start_states;
   return own > 0 ? own : pipeline.collect.start_states;
 }
 
@@ -130,8 +132,6 @@ std::vector<TransitionArtefacts> load_transition_artefacts(const CompositeRecipe
       check_source(q, "q.pt");
       EnvSpec qs = r.spec;
       qs.act_dim = 2;
-      const int with_features = qs.obs_dim + int(qs.feature_names.size());  // switch.interval_features
-      if (q.obs_dim() == with_features) qs.obs_dim = with_features;
       q.check_fits(qs, folder + "q.pt");
       out[t].q = q;
     }

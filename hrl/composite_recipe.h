@@ -26,6 +26,7 @@
 #include "hrl/meta_controller.h"
 #include "hrl/pipeline_config.h"
 #include "hrl/transition_controller.h"
+#include "hrl/transition_training_spec.h"
 #include "hrl/skill.h"
 
 namespace segue {
@@ -35,11 +36,8 @@ struct CompositeRecipe {
   EnvFactory make_env;
   EnvSpec spec;
   std::vector<Skill> skills;
-  MetaController meta;
-  // Per transition, where its S_a and T_b are collected and pi_ab trains: the task with the
-  // transition's `training.env` laid over `env:` (the reference collects and trains in the
-  // sub-tasks' environments, with their pushes); make_env where it has none.
-  std::vector<EnvFactory> training_envs;
+  MetaController meta;  // the run-time rules: start skill, transition intervals
+  std::vector<TransitionTrainingSpec> training;  // per transition, what `segue run` trains it on
   std::string single_policy;    // methods.single.policy ("" when absent)
   std::string transitions_dir;  // methods.transitions ("" when absent)
   PipelineConfig pipeline;

@@ -43,6 +43,8 @@ EvalResult run_jobs(const EnvFactory& make_env, int jobs, const std::function<ui
   r.success_counts.assign(jobs, 0.0);
   r.lengths.assign(jobs, 0.0);
   r.successes.assign(jobs, 0);
+  r.terminated.assign(jobs, 0);
+  r.ended_under.assign(jobs, "");
   r.metric_names = spec.metric_names;
   r.metric_means.assign(K, std::vector<double>(jobs, 0.0));
 
@@ -78,6 +80,8 @@ EvalResult run_jobs(const EnvFactory& make_env, int jobs, const std::function<ui
       for (int k = 0; k < K; ++k) r.metric_means[k][e] += sr.info.metrics[k];
       if (sr.done()) {
         r.successes[e] = sr.info.success;
+        r.terminated[e] = sr.terminated;
+        r.ended_under[e] = controller[s]->in_control();
         r.success_counts[e] = sr.info.success_count;
         for (int k = 0; k < K; ++k) r.metric_means[k][e] /= r.lengths[e];
         job_of[s] = -2, done_job[s] = e;
@@ -105,6 +109,14 @@ EvalResult run_jobs(const EnvFactory& make_env, int jobs, const std::function<ui
 
 double EvalResult::success_rate() const {
   return successes.empty() ? 0.0 : double(std::count(successes.begin(), successes.end(), 1)) / successes.size();
+}
+
+void EvalResult::append(const EvalResult& more) {
+  auto add = [](auto& to, const auto& from) { to.insert(to.end(), from.begin(), from.end()); };
+  add(returns, more.returns), add(success_counts, more.success_counts), add(lengths, more.lengths);
+  add(successes, more.successes), add(terminated, more.terminated), add(ended_under, more.ended_under);
+  if (metric_names.empty()) metric_names = more.metric_names, metric_means.resize(more.metric_means.size());
+  for (size_t k = 0; k < metric_means.size() && k < more.metric_means.size(); ++k) add(metric_means[k], more.metric_means[k]);
 }
 
 EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_controller, int episodes,

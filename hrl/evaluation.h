@@ -14,9 +14,12 @@ namespace segue {
 struct EvalResult {
   std::vector<double> returns, success_counts, lengths;
   std::vector<uint8_t> successes;
+  std::vector<uint8_t> terminated;        // ended by the task (success, a fall), not its time limit
+  std::vector<std::string> ended_under;   // Controller::in_control() at the episode's last step
   std::vector<std::string> metric_names;
   std::vector<std::vector<double>> metric_means;  // [metric][episode]: per-step mean
   double success_rate() const;  // the fraction of episodes that succeeded
+  void append(const EvalResult& more);  // more's episodes after these
 };
 
 struct Summary {

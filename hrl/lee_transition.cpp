@@ -2,19 +2,20 @@
 
 #include <algorithm>
 
-#include "hrl/switch_training.h"
+#include "hrl/switch_interval.h"
 
 namespace segue {
 
-LeeTransitionEnv::LeeTransitionEnv(const CompositeRecipe& r, int transition, StartStates starts,
+LeeTransitionEnv::LeeTransitionEnv(const EnvFactory& make_env, const std::vector<Skill>& skills,
+                                   const MetaController& meta, int transition, StartStates starts,
                                    int max_subtask_steps)
-    : to_(r.meta.transitions().at(transition).to),
-      inner_(r.make_env(), std::move(starts), r.meta.transitions()[transition], r.skills[to_].obs_begin,
-             r.skills[to_].obs_end),
+    : to_(meta.transitions().at(transition).to),
+      inner_(make_env(), std::move(starts), meta.transitions()[transition], skills[to_].obs_begin,
+             skills[to_].obs_end),
       max_subtask_steps_(max_subtask_steps),
-      pi_b_(r.skills, r.meta, {}, SwitchRule::IntervalEnd) {
+      pi_b_(skills, meta, {}, SwitchRule::IntervalEnd) {
   spec_ = inner_.spec();
-  spec_.name = r.spec.name + " (Lee transition)";
+  spec_.name += " (Lee et al.)";
   spec_.act_dim += 1;  // the termination output
   spec_.act_low.push_back(-1.0f);
   spec_.act_high.push_back(1.0f);

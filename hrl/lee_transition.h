@@ -22,7 +22,10 @@ namespace segue {
 // Every episode ends as a true end at the hand-over; info.success is pi_b's outcome.
 class LeeTransitionEnv : public Env {
  public:
-  LeeTransitionEnv(const CompositeRecipe& recipe, int transition, StartStates starts, int max_subtask_steps);
+  // Transition `transition` of `meta` in environments of `make_env`, from S_a's states;
+  // pi_b's run after a hand-over is cut, and counted a success, after max_subtask_steps.
+  LeeTransitionEnv(const EnvFactory& make_env, const std::vector<Skill>& skills, const MetaController& meta,
+                   int transition, StartStates starts, int max_subtask_steps);
   const EnvSpec& spec() const override { return spec_; }
   void reset(uint64_t seed, float* obs) override;
   void reset(float* obs) override;

@@ -39,8 +39,7 @@ std::vector<Condition> read_when(const Section& s, const std::vector<std::string
 }
 
 MetaController::MetaController(const Section& root, const std::vector<Skill>& skills,
-                               const std::vector<std::string>& features,
-                               const std::function<std::vector<std::string>(const std::string&)>& task_features) {
+                               const std::vector<std::string>& features) {
   for (const Section& rule : root.items("start"))
     start_.push_back({find_skill(rule, "skill", skills), read_when(rule, features)});
   if (start_.empty()) throw root.error("start", "lists no start skill");
@@ -48,41 +47,8 @@ MetaController::MetaController(const Section& root, const std::vector<Skill>& sk
     Transition tr;
     tr.from = find_skill(t, "from", skills);
     tr.to = find_skill(t, "to", skills);
-    tr.when = tr.expert_when = read_when(t, features);
-    // The default 0 stands for an absent key (the pipeline's collect.start_states; no cap):
-    // a default is not range-checked, a value written is.
-    tr.start_states = t.get<int>("start_states", 0, Range::positive());
-    tr.max_steps = t.get<int>("max_steps", 0, Range::positive());
-    Section w = t.sub("training");
-    if (w.has("when") || w.has("max_steps")) {
-      if (w.has("when")) tr.training_when = read_when(w, features);
-      tr.training_max_steps = w.get<int>("max_steps", 0, Range::positive());
-    } else if (t.has("training") && !w.has("env")) {
-      throw t.error("training", "give its window (when and/or max_steps) or its env");
-    } else {
-      tr.training_when = tr.when, tr.training_max_steps = tr.max_steps;
-    }
-    if (t.has("expert")) {
-      Section e = t.sub("expert");
-      tr.expert_task = e.get<std::string>("task", "");
-      tr.expert_successful = e.get<bool>("successful", false);
-      tr.expert_after_handover = e.get<bool>("after_handover", false);
-      if (tr.expert_task.empty()) {
-        if (e.has("when")) tr.expert_when = read_when(e, features);  // else the interval
-      } else {
-        if (tr.expert_after_handover) throw e.error("after_handover", "S_a's states are this task's; not with expert.task");
-        if (!e.has("steps") && !e.has("when"))
-          throw e.error("task", "give pi_b's window on it: expert.steps and/or expert.when (over its features)");
-        std::vector<std::string> own;
-        try {
-          own = task_features ? task_features(tr.expert_task) : std::vector<std::string>{};
-        } catch (const Error& err) {
-          throw e.error("task", err.what());
-        }
-        tr.expert_when = read_when(e, own);
-        tr.expert_steps = e.get<int>("steps", 0, Range::positive());
-      }
-    }
+    tr.when = read_when(t, features);
+    tr.max_steps = t.get<int>("max_steps", 0, Range::positive());  // 0: no cap (not range-checked)
     for (const Transition& other : transitions_)
       if (other.from == tr.from && other.to == tr.to)
         throw t.error("to", "a second transition " + skills[tr.from].name + " -> " + skills[tr.to].name +
@@ -101,12 +67,6 @@ double Transition::progress(const double* entry, const double* f, int steps) con
   for (const Condition& c : when)
     if (c.hi > c.lo) return std::abs(f[c.feature] - entry[c.feature]) / (c.hi - c.lo);
   return 1.0;
-}
-
-Transition Transition::training_window() const {
-  Transition w = *this;
-  w.when = training_when, w.max_steps = training_max_steps;
-  return w;
 }
 
 bool MetaController::holds(const std::vector<Condition>& when, const double* f) {

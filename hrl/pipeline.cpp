@@ -90,8 +90,10 @@ int collect_shared(const Distributed& group, const std::string& file, int count,
 }
 
 // Returns the signal number when stopped (nothing of the unfinished set is kept), else 0.
+// s_a: S_a as collected (read from its file once).
 int collect(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
-            const std::atomic<int>* stop, const Distributed& group, int threads, JobPlan& plan) {
+            const std::function<const StartStates&()>& s_a, const std::atomic<int>* stop, const Distributed& group,
+            int threads, JobPlan& plan) {
   const CollectConfig& c = r.pipeline.collect;
   const std::string name = r.transition_name(t);
   if (group.any(group.leader() && exists(dir + "/start_states.pt"))) {
@@ -111,7 +113,7 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
     plan.skip(name + " T_b");
   } else {
     plan.begin(name + " T_b");
-    const Transition& tr = r.meta.transitions()[t];
+    const TransitionTrainingSpec& tr = r.training[t];
     if (tr.expert_after_handover)
       spdlog::info("  collecting T_b: at most {} steps of pi_b in its window, taking over at S_a's states",
                    c.demonstrations);
@@ -125,7 +127,7 @@ int collect(const CompositeRecipe& r, int t, const std::string& run, const std::
     // After the hand-over: from S_a's states less those held out for the switch margin.
     StartStates handovers;
     if (tr.expert_after_handover) {
-      handovers = starts_of(r, t, dir);
+      handovers = s_a();
       handovers.keep_first(handovers.size() - r.pipeline.switching.validation_starts);
       // Each rank takes over at its own block of them.
       const Shard mine = group.shard(handovers.size(), dir + "/start_states.pt");
@@ -175,14 +177,14 @@ void resume(Trainer& trainer, const std::string& ckpt, const Distributed& group)
 }
 
 // Algorithm 1. "success" in its log: episodes that reach the interval's end on their feet.
-int train_transition(const CompositeRecipe& r, int t, const std::string& dir, const PipelineOptions& o) {
+int train_transition(const CompositeRecipe& r, int t, const StartStates& starts, const std::string& dir,
+                     const PipelineOptions& o) {
   const TransitionPolicyConfig& cfg = r.pipeline.transition;
   const Transition& tr = r.meta.transitions()[t];
   const Skill& b = r.skills[tr.to];
-  StartStates starts = starts_of(r, t, dir);
   const Shard share = o.group->shard(cfg.ppo.num_envs, "transition.ppo.num_envs");
   VectorEnv envs(
-      [&] { return std::make_unique<TransitionEnv>(r.training_envs[t](), starts, tr.training_window(), b.obs_begin, b.obs_end); },
+      [&] { return std::make_unique<TransitionEnv>(r.training[t].env(), starts, r.training[t].window(tr), b.obs_begin, b.obs_end); },
       share.count, o.threads, share.first);
   TransitionPolicyTrainer trainer(cfg, envs, demonstrations_of(r, t, dir), b.policy,
                                   mix_seed(r.pipeline.seed, 100 + t), *o.group);
@@ -206,13 +208,13 @@ int train_transition(const CompositeRecipe& r, int t, const std::string& dir, co
 }
 
 // Lee et al. 2019. "success" in its log: hand-overs after which pi_b succeeded.
-int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const PipelineOptions& o) {
+int train_lee(const CompositeRecipe& r, int t, const StartStates& starts, const std::string& dir,
+              const PipelineOptions& o) {
   const TransitionPolicyConfig cfg = r.pipeline.lee.transition(r.pipeline.transition);
   const Skill& b = r.skills[r.meta.transitions()[t].to];
-  StartStates starts = starts_of(r, t, dir);
   const int subtask_steps = r.pipeline.switching.max_subtask_steps;
   const Shard share = o.group->shard(cfg.ppo.num_envs, "transition.ppo.num_envs");
-  VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r, t, starts, subtask_steps); }, share.count,
+  VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r.make_env, r.skills, r.meta, t, starts, subtask_steps); }, share.count,
                  o.threads, share.first);
   LeeTrainer trainer(cfg, r.pipeline.lee, envs, demonstrations_of(r, t, dir), b.policy,
                      mix_seed(r.pipeline.seed, 300 + t), *o.group);
@@ -237,11 +239,14 @@ int train_lee(const CompositeRecipe& r, int t, const std::string& dir, const Pip
 // signal number when stopped, else 0.
 // With several ranks the attempts are split between them (SwitchTrainer); rank 0 writes
 // and chooses the margin while the others wait.
-int train_switch(const CompositeRecipe& r, int t, const std::string& run, const std::string& dir,
-                 const std::atomic<int>* stop, const Distributed& group, JobPlan& plan) {
+int train_switch(const CompositeRecipe& r, int t, const StartStates& starts, const std::string& run,
+                 const std::string& dir, const std::atomic<int>* stop, const Distributed& group, JobPlan& plan) {
   const SwitchConfig& cfg = r.pipeline.switching;
-  SwitchTrainer trainer(cfg, r, t, starts_of(r, t, dir), Policy::load(dir + "/policy.pt"),
-                        load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false),
+  SwitchTrainer trainer(cfg,
+                        SwitchInterval(r.make_env, r.skills, r.meta, t, starts,
+                                       Policy::load(dir + "/policy.pt"),
+                                       load_transition_artefacts(r, run, "policy.pt", /*with_q=*/false),
+                                       cfg.lookahead, cfg.max_subtask_steps),
                         mix_seed(r.pipeline.seed, 200 + t), group);
   const std::string ckpt = dir + "/switch_checkpoint.pt";
   const int chunk = std::clamp(cfg.attempts / 10, 1, 100);
@@ -296,11 +301,11 @@ int train_switch(const CompositeRecipe& r, int t, const std::string& run, const 
 
 // Fig. 4's data: from the same S_a states, each of pi_a, pi_ab and pi_b drives through
 // the interval; every action is a row "label,a0,...".
-void write_actions(const CompositeRecipe& r, int t, const std::string& dir, int starts_used = 40) {
+void write_actions(const CompositeRecipe& r, int t, const StartStates& starts, const std::string& dir,
+                   int starts_used = 40) {
   const Transition& tr = r.meta.transitions()[t];
   const Skill& a = r.skills[tr.from];
   const Skill& b = r.skills[tr.to];
-  StartStates starts = starts_of(r, t, dir);
   Policy pi_ab = Policy::load(dir + "/policy.pt");
   auto env = r.make_env();
   std::vector<float> obs(r.spec.obs_dim), act(r.spec.act_dim);
@@ -392,38 +397,45 @@ int run_pipeline(const CompositeRecipe& recipe, const PipelineOptions& o) {
     return stop;
   };
   auto tdir = [&](int t) { return run + "/" + recipe.transition_name(t); };
+  // Each transition's S_a, read from its folder once, after its collection.
+  std::vector<std::optional<StartStates>> s_a(static_cast<size_t>(n));
+  auto starts = [&](int t) -> const StartStates& {
+    if (!s_a[t]) s_a[t] = starts_of(recipe, t, tdir(t));
+    return *s_a[t];
+  };
   // Every pi_ab first: S_a of a later transition is collected With TP through the earlier
   // ones, and switch training may carry episodes on through any of them (lookahead).
   for (int t = 0; t < n; ++t) {
     if (group.leader()) fs::create_directories(tdir(t));
     group.leader_done("the transition's folder");
     announce(recipe.transition_name(t) + ": collect S_a and T_b");
-    if (int stop = collect(recipe, t, run, tdir(t), o.stop, group, o.threads, plan)) {
+    if (int stop = collect(recipe, t, run, tdir(t), [&]() -> const StartStates& { return starts(t); }, o.stop, group,
+                           o.threads, plan)) {
       spdlog::warn("interrupted: rerun the same command to resume (this collection starts over)");
       return stop;
     }
     announce(recipe.transition_name(t) + ": transition policy (AIRL, Algorithm 1)");
     if (int stop = stage_unless_done(recipe.transition_name(t) + " pi_ab", tdir(t) + "/policy.pt",
-                                     [&] { return train_transition(recipe, t, tdir(t), o); }))
+                                     [&] { return train_transition(recipe, t, starts(t), tdir(t), o); }))
       return stop;
   }
   for (int t = 0; t < n; ++t) {
     announce(recipe.transition_name(t) + ": switch Q-network (double DQN, Algorithm 2)");
     if (int stop = stage_unless_done(recipe.transition_name(t) + " q_ab", tdir(t) + "/q.pt",
-                                     [&] { return train_switch(recipe, t, run, tdir(t), o.stop, group, plan); }))
+                                     [&] { return train_switch(recipe, t, starts(t), run, tdir(t), o.stop, group, plan); }))
       return stop;
   }
   for (int t = 0; t < n && lee; ++t) {
     announce(recipe.transition_name(t) + ": Lee et al. 2019 baseline (proximity reward, termination head)");
     if (int stop = stage_unless_done(recipe.transition_name(t) + " Lee", tdir(t) + "/lee.pt",
-                                     [&] { return train_lee(recipe, t, tdir(t), o); }))
+                                     [&] { return train_lee(recipe, t, starts(t), tdir(t), o); }))
       return stop;
   }
   if (!group.leader()) return 0;  // rank 0 evaluates
   announce("evaluate every method");
   plan.begin("evaluate");
   for (int t = 0; t < n; ++t)
-    if (!exists(tdir(t) + "/actions.csv")) write_actions(recipe, t, tdir(t));
+    if (!exists(tdir(t) + "/actions.csv")) write_actions(recipe, t, starts(t), tdir(t));
   const std::string table = run + "/" + recipe.task + ".json";
   if (exists(table)) {
     spdlog::info("  done already: {} (remove it to measure again)", table);

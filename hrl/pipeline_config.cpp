@@ -1,5 +1,6 @@
 #include "hrl/pipeline_config.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/thread_pool.h"
@@ -18,7 +19,7 @@ CollectConfig CollectConfig::read(const Section& s) {
   return c;
 }
 
-TransitionPolicyConfig TransitionPolicyConfig::read(const Section& s, int obs_dim) {
+TransitionPolicyConfig TransitionPolicyConfig::read(const Section& s) {
   TransitionPolicyConfig c;
   c.ppo.lr = 1e-4;  // policy Adam 1e-4, the paper's text (docs/reference/learners.md)
   c.ppo.total_steps = 1'000'000;
@@ -37,8 +38,6 @@ TransitionPolicyConfig TransitionPolicyConfig::read(const Section& s, int obs_di
   c.disc_lr = d.get("lr", c.disc_lr, Range::positive());
   c.disc_batch = d.get("batch", c.disc_batch, Range::closed(1, kMaxBatch));
   c.disc_steps = d.get("steps", c.disc_steps, Range::non_negative());
-  c.gradient_penalty = d.get("gradient_penalty", c.gradient_penalty, Range::non_negative());
-  if (d.has("fourier")) c.discriminator.features = ObsFeatures::read(d.sub("fourier"), obs_dim);
   return c;
 }
 
@@ -50,7 +49,7 @@ ActorCriticSpec TransitionPolicyConfig::network(const EnvSpec& env, const Policy
   return n;
 }
 
-SwitchConfig SwitchConfig::read(const Section& s, int obs_dim) {
+SwitchConfig SwitchConfig::read(const Section& s) {
   SwitchConfig c;
   c.net.hidden = s.layers("hidden", c.net.hidden);
   c.net.gamma = s.get("gamma", c.net.gamma, Range::open_closed(0, 1));
@@ -70,12 +69,14 @@ SwitchConfig SwitchConfig::read(const Section& s, int obs_dim) {
   c.lookahead = s.get("lookahead", c.lookahead, Range::at_least(1));
   c.validation_starts = s.get("validation_starts", c.validation_starts, Range::non_negative());
   c.margins = s.get("margins", c.margins, Range::any());
-  c.interval_features = s.get("interval_features", c.interval_features);
-  c.ensemble = s.get("ensemble", c.ensemble, Range::closed(1, 64));
-  if (s.has("fourier")) c.features = ObsFeatures::read(s.sub("fourier"), obs_dim);  // only when given
   if (c.margins.empty()) throw s.error("margins", "lists no margin");
   if (c.replay < c.batch) throw s.error("replay", "must hold at least one batch");
   return c;
+}
+
+double SwitchConfig::epsilon(int attempt) const {
+  const double frac = std::min(1.0, attempt / (explore_fraction * std::max(attempts, 1)));
+  return epsilon_start + frac * (epsilon_end - epsilon_start);
 }
 
 LeeConfig LeeConfig::read(const Section& s) {
@@ -98,14 +99,14 @@ TransitionPolicyConfig LeeConfig::transition(const TransitionPolicyConfig& tp) c
   return c;
 }
 
-PipelineConfig PipelineConfig::read(const Section& root, const std::string& task, int obs_dim) {
+PipelineConfig PipelineConfig::read(const Section& root, const std::string& task) {
   PipelineConfig c;
   c.run_dir = root.get("run_dir", "runs/" + task);
   c.seed = root.get<uint64_t>("seed", c.seed);
   c.threads = root.get("threads", c.threads, Range::closed(0, kMaxThreads));
   c.collect = CollectConfig::read(root.sub("collect"));
-  c.transition = TransitionPolicyConfig::read(root.sub("transition"), obs_dim);
-  c.switching = SwitchConfig::read(root.sub("switch"), obs_dim);
+  c.transition = TransitionPolicyConfig::read(root.sub("transition"));
+  c.switching = SwitchConfig::read(root.sub("switch"));
   c.lee = LeeConfig::read(root.sub("lee"));
   return c;
 }

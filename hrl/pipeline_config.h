@@ -7,8 +7,7 @@
 //   threads: 0
 //   collect: {start_states: 1000, demonstrations: 100000}     # |S_a|, |T_b| per transition
 //   transition: {ppo: {...}, policy: {...}, init_from_next: true,
-//                discriminator: {hidden: [100, 100], lr: 3.0e-4, batch: 256, steps: 16, gradient_penalty: 0,
-//                                fourier: {...}}}
+//                discriminator: {hidden: [100, 100], lr: 3.0e-4, batch: 256, steps: 16}}
 //   switch: {attempts: 2000, lr: 1.0e-4, ...}
 #include <string>
 #include <vector>
@@ -45,11 +44,9 @@ struct TransitionPolicyConfig {
   double disc_lr = 3e-4;         // Adam (paper and code)
   int disc_batch = 256;          // expert and generator rows per discriminator step, each
   int disc_steps = 16;           // discriminator steps per PPO iteration
-  double gradient_penalty = 0.0; // weight of Discriminator::gradient_penalty in D's loss (0: off, the paper's)
 
-  // Reads the recipe's `transition:` section (every key has a default) for observations
-  // of width obs_dim.
-  static TransitionPolicyConfig read(const Section& s, int obs_dim);
+  // Reads the recipe's `transition:` section (every key has a default).
+  static TransitionPolicyConfig read(const Section& s);
   // pi_ab's network on its environment: sized to it and, when pi_ab starts as pi_b
   // (init_from_next), with pi_b's periodic input features, so it can start as exactly pi_b.
   ActorCriticSpec network(const EnvSpec& env, const Policy& next) const;
@@ -69,6 +66,7 @@ struct SwitchConfig {
   // Epsilon is drawn once per attempt; a random attempt switches at a uniform point of
   // the interval (reference). It decays linearly to epsilon_end over explore_fraction.
   double epsilon_start = 1.0, epsilon_end = 0.1, explore_fraction = 0.5;
+  double epsilon(int attempt) const;  // before attempt `attempt` (0-based)
   int max_subtask_steps = 3000;  // pi_b's run is cut (and counted a success) after this
   // How many transition intervals must begin after a hand-over for it to count as r_s
   // (run_subtask): 1 is the paper's (pi_b reaches its own end); 2 also asks that the
@@ -82,23 +80,8 @@ struct SwitchConfig {
   // makes it switch early for nothing; the held-out check keeps that from costing.
   int validation_starts = 0;
   std::vector<double> margins{0.0, 0.25, 0.5, 1.0, 2.0};
-  // `fourier:` periodic features of q_ab's inputs, as a policy's (algorithms/obs_features.h):
-  // whether a hand-over succeeds can hinge on where in pi_b's stride an obstacle falls.
-  ObsFeatures features;
-  // `interval_features: true`: q_ab also reads the task's features (env.h: what transition
-  // intervals are written in, e.g. Patrol's steps since the turn), after the observation.
-  // The paper's q_ab reads the state only; where the interval's end is not visible in the
-  // state (Patrol's walker stands still through walk->balance's 100 steps), q_ab cannot
-  // tell how soon the forced switch comes.
-  bool interval_features = false;
-  // `ensemble: K`: K q-networks, each a double DQN on the same replay buffer with its own
-  // initialisation and minibatches; q_ab is their mean (exported as one MLP, K times as
-  // wide, block-diagonal). 1 is the paper's single network. The mean's estimation noise
-  // is smaller, and noise is what makes a greedy q_ab switch early for nothing.
-  int ensemble = 1;
 
-  // obs_dim: the composite task's observation width (the features' inputs index it).
-  static SwitchConfig read(const Section& s, int obs_dim);
+  static SwitchConfig read(const Section& s);
 };
 
 // Lee et al. 2019's transition policy: the generator's PPO and network are `transition:`'s;
@@ -128,7 +111,7 @@ struct PipelineConfig {
   TransitionPolicyConfig transition;
   SwitchConfig switching;
   LeeConfig lee;
-  static PipelineConfig read(const Section& root, const std::string& task, int obs_dim);
+  static PipelineConfig read(const Section& root, const std::string& task);
 };
 
 }  // namespace segue

@@ -19,7 +19,6 @@ void TransitionController::reset(const Env& env, const float*, uint64_t seed) {
 
 void TransitionController::resume(const Env& env, int skill) {
   features_.resize(env.spec().feature_names.size());
-  obs_dim_ = env.spec().obs_dim;
   skill_ = skill;
   transition_ = -1;
   entered_ = -1;
@@ -38,10 +37,7 @@ bool TransitionController::hand_over(const float* obs) {
   const TransitionArtefacts& a = artefacts_[transition_];
   if (rule_ == SwitchRule::QNetwork && a.q) {
     float q[2];
-    const bool with_features = a.q->obs_dim() > obs_dim_;  // q_ab reads the task's features too
-    q_in_.resize(size_t(a.q->obs_dim()));
-    switch_input(obs, obs_dim_, features_, with_features, q_in_.data());
-    a.q->act(q_in_.data(), 1, q);
+    a.q->act(obs, 1, q);
     return q[1] > q[0];
   }
   return false;

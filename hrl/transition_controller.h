@@ -31,17 +31,8 @@ enum class HandOverPoint { Fixed, Random };
 
 struct TransitionArtefacts {
   std::optional<Policy> policy;  // pi_ab, on pi_b's observation slice
-  std::optional<Policy> q;       // q_ab, on switch_input(): [Q(stay), Q(switch)]
+  std::optional<Policy> q;       // q_ab, on the task observation: [Q(stay), Q(switch)]
 };
-
-// q_ab's input: the task observation (obs_dim numbers), then, for a q_ab trained with
-// switch.interval_features, the task's features. Switch training and the controller both
-// build it here, so the two cannot disagree on its layout.
-inline void switch_input(const float* obs, int obs_dim, const std::vector<double>& features, bool with_features,
-                         float* out) {
-  std::copy(obs, obs + obs_dim, out);
-  if (with_features) std::copy(features.begin(), features.end(), out + obs_dim);
-}
 
 class TransitionController : public Controller {
  public:
@@ -73,8 +64,7 @@ class TransitionController : public Controller {
   Rng rng_;                  // the random hand-over points, from the episode's seed
   double hand_over_at_ = 1;  // the drawn point (HandOverPoint::Random), in Transition::progress
   std::vector<double> features_, entry_features_;
-  std::vector<float> out_, q_in_;
-  int obs_dim_ = 0;
+  std::vector<float> out_;
   int skill_ = 0, transition_ = -1, steps_ = 0;  // steps_: pi_ab's in this interval
   int entered_ = -1;
   std::vector<char> taken_;  // per transition: entered, and its interval not left since

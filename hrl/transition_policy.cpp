@@ -71,15 +71,13 @@ void TransitionPolicyTrainer::discriminate(RolloutBuffer& buf) {
     auto e_logit = disc_->logit(eo, ea, en, ed, e_logpi);
     auto g_logit = disc_->logit(obs.index_select(0, gi), act.index_select(0, gi), next.index_select(0, gi),
                                 done.index_select(0, gi), log_pi.index_select(0, gi));
-    auto bce = disc_->loss(e_logit, g_logit);
-    auto loss = bce;
-    if (cfg_.gradient_penalty > 0) loss = bce + cfg_.gradient_penalty * disc_->gradient_penalty(eo, ea, en, ed);
+    auto loss = disc_->loss(e_logit, g_logit);
     disc_opt_->zero_grad();
     (loss / double(W)).backward();
     const double l = group.sum_gradients(disc_->parameters(), loss.item<double>() / W);  // the mean over ranks
     if (!std::isfinite(l)) throw Error("discriminator loss became " + std::to_string(l));
     disc_opt_->step();
-    stats[0] += bce.item<double>();  // the logged loss is D's cross-entropy alone
+    stats[0] += loss.item<double>();
     stats[1] += (e_logit > 0).to(torch::kFloat32).mean().item<double>();
     stats[2] += (g_logit < 0).to(torch::kFloat32).mean().item<double>();
   }

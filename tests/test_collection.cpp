@@ -239,8 +239,8 @@ TEST(Collection, DemonstrationsFromTheSkillsOwnTaskAreItsFirstSteps) {
   CompositeRecipe r = CompositeRecipe::load(CompositeRecipe::default_file("obstacle_course"));
   const int t = 1;  // walk -> crawl
   ASSERT_EQ(r.transition_name(t), "walk-crawl");
-  ASSERT_EQ(r.meta.transitions()[t].expert_task, "walker_crawl");
-  const int steps = r.meta.transitions()[t].expert_steps;
+  ASSERT_EQ(r.training[t].expert_task, "walker_crawl");
+  const int steps = r.training[t].expert_steps;
   Demonstrations d = collect_demonstrations(r, t, steps + 20, 5);
   ASSERT_EQ(d.size(), steps + 20);
   ASSERT_EQ(d.obs_dim, 26);
@@ -265,13 +265,13 @@ TEST(Collection, DemonstrationsFromTheSkillsOwnTaskAreItsFirstSteps) {
 TEST_F(CollectionFiles, SuccessfulDemonstrationsAreTheWindowsPiBSucceedsFrom) {
   // Stage 13's jump (38%), so that some windows are dropped whatever the shipped jump's rate.
   CompositeRecipe r = hurdle_with_stage13_jump("");
-  const Transition& tr = r.meta.transitions()[0];
+  const TransitionTrainingSpec& tr = r.training[0];
   ASSERT_TRUE(tr.expert_successful);
   const int count = 300;
   Demonstrations d = collect_demonstrations(r, 0, count, 11);
 
   auto env = r.make_env();
-  const Skill& jump = r.skills[tr.to];
+  const Skill& jump = r.skills[r.meta.transitions()[0].to];
   const int D = jump.obs_end - jump.obs_begin;
   std::vector<float> obs(env->spec().obs_dim), act(env->spec().act_dim), want;
   std::vector<double> f(env->spec().feature_names.size());
@@ -332,9 +332,9 @@ TEST_F(CollectionFiles, ATransitionsTrainingEnvIsTheTaskWithItsSettingsLaidOverE
     }
     return out;
   };
-  EXPECT_EQ(trace(a.training_envs[0]), trace(b.make_env));
+  EXPECT_EQ(trace(a.training[0].env), trace(b.make_env));
   EXPECT_NE(trace(a.make_env), trace(b.make_env));  // the pushes act
-  EXPECT_EQ(trace(a.training_envs[1]), trace(a.make_env));
+  EXPECT_EQ(trace(a.training[1].env), trace(a.make_env));
 
   StartStates sa = collect_start_states(a, 0, 8, 4), sb = collect_start_states(b, 0, 8, 4);
   EXPECT_EQ(sa.states, sb.states);
@@ -375,7 +375,7 @@ TEST_F(CollectionFiles, ExpertWindowsAreCheckedAtLoadAndAfterAThousandEmptyEpiso
 // restore each state, run the jump while T_b's window (expert.when) holds, then on to its next success.
 TEST_F(CollectionFiles, DemonstrationsAfterTheHandOverStartAtSaAndKeepTheWindowsPiBSucceedsFrom) {
   CompositeRecipe r = hurdle_with_stage13_jump(", after_handover: true");
-  const Transition& tr = r.meta.transitions()[0];
+  const TransitionTrainingSpec& tr = r.training[0];
   ASSERT_TRUE(tr.expert_after_handover && tr.expert_successful);
   StartStates s = collect_start_states(r, 0, 24, 4);
   s.keep_first(20);  // as the pipeline drops the held-out states
@@ -384,7 +384,7 @@ TEST_F(CollectionFiles, DemonstrationsAfterTheHandOverStartAtSaAndKeepTheWindows
   Demonstrations d = collect_demonstrations(r, 0, 100000, 9, kDemonstrationEpisodes, nullptr, &s);
 
   auto env = r.make_env();
-  const Skill& jump = r.skills[tr.to];
+  const Skill& jump = r.skills[r.meta.transitions()[0].to];
   std::vector<float> obs(env->spec().obs_dim), act(env->spec().act_dim), want;
   std::vector<double> f(env->spec().feature_names.size()), state;
   int kept = 0, dropped = 0, later_curbs = 0;

@@ -5,11 +5,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "tests/task_fixture.h"
 #include "environments/walker_course.h"
 #include "environments/walker_patrol.h"
 #include "hrl/meta_controller.h"
+#include "hrl/transition_training_spec.h"
 
 namespace segue {
 namespace {
@@ -361,7 +363,15 @@ TEST(MetaController, RefusesUnknownSkillsAndFeatures) {
   EXPECT_THROW(MetaController(bad_feature.root(), skills, {"curb_ahead"}), Error);
 }
 
-TEST(MetaController, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
+// Transition 0's training spec (hrl/transition_training_spec.h), read as a composite
+// recipe reads it: the rule first, then the training keys of the same entry.
+static TransitionTrainingSpec spec_of(const Recipe& r, const std::vector<Skill>& skills, const std::vector<std::string>& features,
+                                      const std::function<std::vector<std::string>(const std::string&)>& own = nullptr) {
+  MetaController meta(r.root(), skills, features);
+  return TransitionTrainingSpec::read(r.root().items("transitions")[0], meta.transitions()[0], features, own);
+}
+
+TEST(TransitionTrainingSpec, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
   std::vector<Skill> skills(2);
   skills[0].name = "walk";
   skills[1].name = "crawl";
@@ -372,12 +382,12 @@ TEST(MetaController, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
     if (task != "walker_crawl") throw Error("unknown task '" + task + "'");
     return std::vector<std::string>{"steps", "ceiling_behind"};
   };
-  MetaController meta(ok.root(), skills, {"ceiling_ahead"}, own);
-  EXPECT_EQ(meta.transitions()[0].expert_task, "walker_crawl");
-  EXPECT_EQ(meta.transitions()[0].expert_steps, 150);
-  EXPECT_TRUE(meta.transitions()[0].expert_when.empty());  // not the interval: that is this task's
+  const TransitionTrainingSpec spec = spec_of(ok, skills, {"ceiling_ahead"}, own);
+  EXPECT_EQ(spec.expert_task, "walker_crawl");
+  EXPECT_EQ(spec.expert_steps, 150);
+  EXPECT_TRUE(spec.expert_when.empty());  // not the interval: that is this task's
   Recipe windowed = Recipe::parse(head + "expert: {task: walker_crawl, when: {ceiling_behind: [1, 2]}}}", "r.yaml");
-  const Transition w = MetaController(windowed.root(), skills, {"ceiling_ahead"}, own).transitions()[0];
+  const TransitionTrainingSpec w = spec_of(windowed, skills, {"ceiling_ahead"}, own);
   EXPECT_EQ(w.expert_steps, 0);
   ASSERT_EQ(w.expert_when.size(), 1u);
   EXPECT_EQ(w.expert_when[0].feature, 1);  // ceiling_behind among the sub-task's features
@@ -385,7 +395,7 @@ TEST(MetaController, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
   auto refused = [&](const std::string& expert, const std::string& message) {
     Recipe r = Recipe::parse(head + "expert: " + expert + "}", "r.yaml");
     try {
-      MetaController(r.root(), skills, {"ceiling_ahead"}, own);
+      spec_of(r, skills, {"ceiling_ahead"}, own);
       ADD_FAILURE() << expert;
     } catch (const Error& e) {
       EXPECT_EQ(std::string(e.what()), message);
@@ -393,22 +403,12 @@ TEST(MetaController, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
   };
   // expert.successful alone keeps the interval as the window.
   Recipe kept = Recipe::parse(head + "expert: {successful: true}}", "r.yaml");
-  MetaController filtered(kept.root(), skills, {"ceiling_ahead"});
-  ASSERT_EQ(filtered.transitions()[0].expert_when.size(), 1u);
-  EXPECT_EQ(filtered.transitions()[0].expert_when[0].lo, 2.0);
-  EXPECT_EQ(filtered.transitions()[0].expert_when[0].hi, 3.0);
-  EXPECT_TRUE(filtered.transitions()[0].expert_successful);
-  EXPECT_FALSE(meta.transitions()[0].expert_successful);
-  EXPECT_EQ(meta.transitions()[0].max_steps, 0);  // no cap unless asked
-  Recipe capped = Recipe::parse(head + "max_steps: 300}", "r.yaml");
-  EXPECT_EQ(MetaController(capped.root(), skills, {"ceiling_ahead"}).transitions()[0].max_steps, 300);
-  try {
-    Recipe zero = Recipe::parse(head + "max_steps: 0}", "r.yaml");
-    MetaController(zero.root(), skills, {"ceiling_ahead"});
-    ADD_FAILURE() << "max_steps 0 was accepted";
-  } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), "r.yaml: key 'transitions.0.max_steps' must be > 0, got 0");
-  }
+  const TransitionTrainingSpec filtered = spec_of(kept, skills, {"ceiling_ahead"});
+  ASSERT_EQ(filtered.expert_when.size(), 1u);
+  EXPECT_EQ(filtered.expert_when[0].lo, 2.0);
+  EXPECT_EQ(filtered.expert_when[0].hi, 3.0);
+  EXPECT_TRUE(filtered.expert_successful);
+  EXPECT_FALSE(spec.expert_successful);
   refused("{task: walker_crawl}", "r.yaml: key 'transitions.0.expert.task': give pi_b's window on it: expert.steps "
                                   "and/or expert.when (over its features)");
   refused("{task: walker_crawl, steps: 0}", "r.yaml: key 'transitions.0.expert.steps' must be > 0, got 0");
@@ -418,21 +418,43 @@ TEST(MetaController, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
   refused("{task: walker_jog, steps: 9}", "r.yaml: key 'transitions.0.expert.task': unknown task 'walker_jog'");
 }
 
-TEST(MetaController, ATrainingWindowApartFromTheInterval) {
+TEST(MetaController, ATransitionsMaxStepsCapsItsInterval) {
+  std::vector<Skill> skills(2);
+  skills[0].name = "walk";
+  skills[1].name = "crawl";
+  const std::string head = "start: [{skill: walk}]\ntransitions:\n  - {from: walk, to: crawl, when: {ceiling_ahead: [2, 3]}";
+  Recipe plain = Recipe::parse(head + "}", "r.yaml");
+  EXPECT_EQ(MetaController(plain.root(), skills, {"ceiling_ahead"}).transitions()[0].max_steps, 0);  // no cap unless asked
+  Recipe capped = Recipe::parse(head + ", max_steps: 300}", "r.yaml");
+  const Transition c = MetaController(capped.root(), skills, {"ceiling_ahead"}).transitions()[0];
+  EXPECT_EQ(c.max_steps, 300);
+  const double inside[1] = {2.5};
+  EXPECT_TRUE(c.running(inside, 299));
+  EXPECT_FALSE(c.running(inside, 300));
+  try {
+    Recipe zero = Recipe::parse(head + ", max_steps: 0}", "r.yaml");
+    MetaController(zero.root(), skills, {"ceiling_ahead"});
+    ADD_FAILURE() << "max_steps 0 was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), "r.yaml: key 'transitions.0.max_steps' must be > 0, got 0");
+  }
+}
+
+TEST(TransitionTrainingSpec, ATrainingWindowApartFromTheInterval) {
   std::vector<Skill> skills(2);
   skills[0].name = "walk";
   skills[1].name = "jump";
   const std::string head = "start: [{skill: walk}]\ntransitions:\n  - {from: walk, to: jump, when: {curb_ahead: [3, 4]}";
   // By default pi_ab trains in the interval itself, with its cap.
   Recipe plain = Recipe::parse(head + ", max_steps: 50}", "r.yaml");
-  const Transition p = MetaController(plain.root(), skills, {"curb_ahead"}).transitions()[0];
+  const TransitionTrainingSpec p = spec_of(plain, skills, {"curb_ahead"});
   ASSERT_EQ(p.training_when.size(), 1u);
   EXPECT_EQ(p.training_when[0].lo, 3.0);
   EXPECT_EQ(p.training_max_steps, 50);
   // The reference's Hurdle: evaluated 4 to 3 m before the curb, trained from 4 to 2 m.
   Recipe wide = Recipe::parse(head + ", max_steps: 50, training: {when: {curb_ahead: [2, 4]}}}", "r.yaml");
   const Transition t = MetaController(wide.root(), skills, {"curb_ahead"}).transitions()[0];
-  const Transition window = t.training_window();
+  const Transition window = spec_of(wide, skills, {"curb_ahead"}).window(t);
   const double at_2_5[1] = {2.5}, at_3_5[1] = {3.5};
   EXPECT_FALSE(t.running(at_2_5, 0));
   EXPECT_TRUE(window.running(at_2_5, 0));
@@ -440,9 +462,11 @@ TEST(MetaController, ATrainingWindowApartFromTheInterval) {
   EXPECT_EQ(window.max_steps, 0);  // a training window without max_steps has no cap
   EXPECT_TRUE(window.running(at_3_5, 1000));
   EXPECT_FALSE(t.running(at_3_5, 50));
+  EXPECT_EQ(window.from, t.from);
+  EXPECT_EQ(window.to, t.to);
   try {
     Recipe empty = Recipe::parse(head + ", training: {}}", "r.yaml");
-    MetaController(empty.root(), skills, {"curb_ahead"});
+    spec_of(empty, skills, {"curb_ahead"});
     ADD_FAILURE() << "an empty training window was accepted";
   } catch (const Error& e) {
     EXPECT_EQ(std::string(e.what()),
@@ -450,7 +474,7 @@ TEST(MetaController, ATrainingWindowApartFromTheInterval) {
   }
   // A training env alone keeps the interval as the window.
   Recipe pushed = Recipe::parse(head + ", max_steps: 50, training: {env: {push_prob: 0.2}}}", "r.yaml");
-  const Transition e = MetaController(pushed.root(), skills, {"curb_ahead"}).transitions()[0];
+  const TransitionTrainingSpec e = spec_of(pushed, skills, {"curb_ahead"});
   ASSERT_EQ(e.training_when.size(), 1u);
   EXPECT_EQ(e.training_when[0].lo, 3.0);
   EXPECT_EQ(e.training_max_steps, 50);

@@ -24,7 +24,7 @@ TEST_F(TransitionTraining, LeeCheckpointKeepsThePredictorsLabelledStates) {
   StartStates starts = collect_start_states(r, 0, 6, 1);
   Demonstrations expert = collect_demonstrations(r, 0, 300, 2);
   auto envs = [&] {
-    return std::make_unique<VectorEnv>([&] { return std::make_unique<LeeTransitionEnv>(r, 0, starts, 500); },
+    return std::make_unique<VectorEnv>([&] { return std::make_unique<LeeTransitionEnv>(r.make_env, r.skills, r.meta, 0, starts, 500); },
                                        r.pipeline.transition.ppo.num_envs, 1);
   };
   auto first_envs = envs();
@@ -51,7 +51,7 @@ TEST_F(TransitionTraining, LeeTerminationHeadStartsAtItsBiasFromRandomWeights) {
     const Skill& b = r.skills[r.meta.transitions()[0].to];
     StartStates starts = collect_start_states(r, 0, 4, 1);
     Demonstrations expert = collect_demonstrations(r, 0, 100, 2);
-    VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r, 0, starts, 500); }, 2, 1);
+    VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r.make_env, r.skills, r.meta, 0, starts, 500); }, 2, 1);
     LeeTrainer lee(r.pipeline.transition, r.pipeline.lee, envs, expert, b.policy, 5);
     const int D = envs.spec().obs_dim, A = envs.spec().act_dim;
     auto obs = random_obs(16, D, 3);
@@ -65,7 +65,7 @@ TEST_F(TransitionTraining, LeeTerminationHeadStartsAtItsBiasFromRandomWeights) {
 TEST_F(TransitionTraining, LeeEpisodesEndAtTheTerminationOutputWithPiBsOutcome) {
   CompositeRecipe r = tiny();
   StartStates starts = collect_start_states(r, 0, 4, 1);
-  LeeTransitionEnv env(r, 0, starts, 500);
+  LeeTransitionEnv env(r.make_env, r.skills, r.meta, 0, starts, 500);
   ASSERT_EQ(env.spec().act_dim, 7);  // pi_b's 6 and the termination output
   std::vector<float> obs(env.spec().obs_dim), act(7, 0.0f);
   for (uint64_t seed = 0; seed < 4; ++seed) {

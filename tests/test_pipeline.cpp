@@ -108,8 +108,8 @@ TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
   // The stage resumes from the checkpoint it finds: one written after 20 attempts leaves
   // 4 to run (2 reports after the stopped run's one).
   {
-    SwitchTrainer later(r.pipeline.switching, r, 0, load_start_states(t + "start_states.pt"),
-                        Policy::load(t + "policy.pt"), {}, 4);
+    SwitchTrainer later =
+        switch_trainer(r, 0, load_start_states(t + "start_states.pt"), Policy::load(t + "policy.pt"), 4);
     later.run(20);
     later.save(t + "switch_checkpoint.pt");
   }

@@ -257,8 +257,8 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run(patrol + "switch.validation_starts=-1"), "key 'switch.validation_starts' must be >= 0, got -1");
   expect_one_line_error(run(patrol + "'switch.margins=[]'"), "key 'switch.margins': lists no margin");
   expect_one_line_error(run(patrol + "switch.gamma=1.5"), "key 'switch.gamma' must be in (0, 1], got 1.5");
-  expect_one_line_error(run(patrol + "transition.discriminator.gradient_penalty=-1"),
-                        "key 'transition.discriminator.gradient_penalty' must be >= 0, got -1");
+  expect_one_line_error(run(patrol + "transition.discriminator.steps=-1"),
+                        "key 'transition.discriminator.steps' must be >= 0, got -1");
   expect_one_line_error(run(patrol + "transitions.0.max_steps=0"), "key 'transitions.0.max_steps' must be > 0, got 0");
 }
 

@@ -1,7 +1,6 @@
-// Algorithm 2 (hrl/switch_training.h): q_ab exports like a policy (an ensemble as its
-// members' mean, periodic input features as computed by hand), training resumes exactly
-// from its checkpoint, the margin is chosen on held-out starts, and run_subtask's
-// lookahead ends at the task's own events.
+// Algorithm 2 (hrl/switch_training.h): q_ab exports like a policy, training resumes exactly
+// from its checkpoint, the margin is chosen on held-out starts (hrl/switch_margin.h), and
+// run_subtask's lookahead ends at the task's own events (hrl/switch_interval.h).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -23,7 +22,7 @@ namespace segue {
 TEST_F(TransitionTraining, SwitchQNetworkExportsAsAPolicy) {
   CompositeRecipe r = tiny();
   const Skill& b = r.skills[r.meta.transitions()[0].to];
-  SwitchTrainer trainer(r.pipeline.switching, r, 0, collect_start_states(r, 0, 6, 1), b.policy, {}, 4);
+  SwitchTrainer trainer = switch_trainer(r, 0, collect_start_states(r, 0, 6, 1), b.policy, 4);
   SwitchStats s = trainer.run(24);
   EXPECT_EQ(s.attempts, 24);
   // The rate is over the 24 attempts: a whole number of them.
@@ -41,56 +40,13 @@ TEST_F(TransitionTraining, SwitchQNetworkExportsAsAPolicy) {
   for (int i = 0; i < 16; ++i) EXPECT_NEAR(a[i], c[i], 1e-5);
 }
 
-// With switch.ensemble: K, q_ab is the members' mean: the exported network (one MLP, K
-// times as wide) equals the average of the members' own LibTorch forwards.
-TEST_F(TransitionTraining, SwitchEnsembleExportsTheMembersMean) {
-  CompositeRecipe r = tiny({"switch.ensemble=3"});
-  const Skill& b = r.skills[r.meta.transitions()[0].to];
-  SwitchTrainer trainer(r.pipeline.switching, r, 0, collect_start_states(r, 0, 6, 1), b.policy, {}, 4);
-  EXPECT_GT(trainer.run(24).loss, 0.0);
-  ASSERT_EQ(trainer.networks().size(), 3u);
-  Policy q = trainer.q_function(0.25);
-  q.export_torchscript(path("q3.pt"));
-  Policy back = Policy::load(path("q3.pt"));
-  auto obs = random_obs(8, q.obs_dim(), 11);
-  std::vector<float> in(size_t(8) * q.in_dim()), got(16), got_back(16);
-  q.normalize(obs.data(), 8, in.data());
-  q.act(obs.data(), 8, got.data());
-  back.act(obs.data(), 8, got_back.data());
-  torch::NoGradGuard no_grad;
-  auto x = torch::from_blob(in.data(), {8, q.in_dim()});
-  torch::Tensor mean = torch::zeros({8, 2});
-  for (SwitchQNetwork net : trainer.networks()) mean += net->forward(x) / 3.0;  // holders share the member
-  mean.select(1, 0) += 0.25;  // the margin, on Q(stay)
-  SwitchQNetwork member = trainer.networks()[0];
-  torch::Tensor first = member->forward(x);
-  first.select(1, 0) += 0.25;
-  double spread = 0;
-  for (int n = 0; n < 8; ++n)
-    for (int j = 0; j < 2; ++j) {
-      EXPECT_NEAR(got[2 * n + j], mean[n][j].item<float>(), 1e-5) << n << "," << j;
-      EXPECT_NEAR(got_back[2 * n + j], got[2 * n + j], 1e-5);
-      spread += std::abs(first[n][j].item<float>() - mean[n][j].item<float>());
-    }
-  EXPECT_GT(spread, 1e-3) << "the members are not distinct networks";
-  try {
-    tiny({"switch.ensemble=0"});
-    ADD_FAILURE() << "an empty ensemble was accepted";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("key 'switch.ensemble' must be in [1, 64], got 0"), std::string::npos) << e.what();
-  }
-}
-
 // A switch stage stopped and resumed from its checkpoint trains exactly the q_ab an
 // unbroken one does: same attempts, same minibatches, same weights.
 TEST_F(TransitionTraining, SwitchTrainingResumesExactlyFromItsCheckpoint) {
-  for (std::string ensemble : {"1", "3"}) {
-  SCOPED_TRACE("ensemble " + ensemble);
-  CompositeRecipe r = tiny({"switch.ensemble=" + ensemble});
+  CompositeRecipe r = tiny();
   const Skill& b = r.skills[r.meta.transitions()[0].to];
   StartStates starts = collect_start_states(r, 0, 6, 1);
-  auto make = [&] { return std::make_unique<SwitchTrainer>(r.pipeline.switching, r, 0, starts, b.policy,
-                                                           std::vector<TransitionArtefacts>{}, 4); };
+  auto make = [&] { return std::make_unique<SwitchTrainer>(switch_trainer(r, 0, starts, b.policy, 4)); };
   auto whole = make();
   whole->run(12);
   whole->run(12);
@@ -108,129 +64,81 @@ TEST_F(TransitionTraining, SwitchTrainingResumesExactlyFromItsCheckpoint) {
   std::vector<float> want = whole->q_function().mlp().parameters(), got = resumed->q_function().mlp().parameters();
   ASSERT_EQ(got.size(), want.size());
   for (size_t i = 0; i < want.size(); ++i) ASSERT_EQ(got[i], want[i]) << "parameter " << i;
-  // Another q_ab's checkpoint (other input width) is refused, naming the file.
-  CompositeRecipe wide = tiny({"switch.fourier={inputs: [0], periods: [1]}"});
-  SwitchTrainer other(wide.pipeline.switching, wide, 0, starts, b.policy, {}, 4);
+  // A checkpoint whose replay buffer the recipe cannot hold is refused, naming the file and key.
+  CompositeRecipe other_replay = tiny({"switch.replay=5000"});
+  SwitchTrainer other = switch_trainer(other_replay, 0, starts, b.policy, 4);
   try {
     other.load(path("switch_checkpoint.pt"));
-    ADD_FAILURE() << "a checkpoint of another width was loaded";
+    ADD_FAILURE() << "a checkpoint of another replay capacity was loaded";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("switch_checkpoint.pt: the checkpoint's q_ab input width differs"),
+    EXPECT_NE(std::string(e.what()).find("switch_checkpoint.pt: the checkpoint's replay buffer has another "
+                                         "capacity or row width than the recipe's (switch.replay"),
               std::string::npos)
         << e.what();
   }
-  }
-}
-
-// switch.fourier: q_ab reads periodic features of chosen observations after its normalised
-// input, as a policy does; the exported q_ab computes exactly that input (by hand here).
-TEST_F(TransitionTraining, SwitchQNetworkReadsPeriodicFeatures) {
-  CompositeRecipe r = tiny({"switch.fourier={inputs: [0, 3], periods: [0.5, 2]}"});
-  const int D = r.spec.obs_dim;
-  const Skill& b = r.skills[r.meta.transitions()[0].to];
-  SwitchTrainer trainer(r.pipeline.switching, r, 0, collect_start_states(r, 0, 6, 1), b.policy, {}, 4);
-  trainer.run(24);
-  Policy q = trainer.q_function();
-  ASSERT_EQ(q.features(), (ObsFeatures{{0, 3}, {0.5, 2}}));
-  ASSERT_EQ(q.mlp().in_dim(), D + 8);
-  auto obs = random_obs(5, D, 7);
-  std::vector<float> got(10), back_got(10), in(D + 8), want(2);
-  q.act(obs.data(), 5, got.data());
-  const double kTwoPi = 6.283185307179586;
-  for (int n = 0; n < 5; ++n) {
-    const float* x = &obs[size_t(n) * D];
-    for (int j = 0; j < D; ++j) in[j] = std::clamp((x[j] - q.obs_mean()[j]) * q.obs_inv_std()[j], -5.0f, 5.0f);
-    int k = D;
-    for (int i : {0, 3})
-      for (double period : {0.5, 2.0}) {
-        in[k++] = float(std::sin(kTwoPi * x[i] / period));
-        in[k++] = float(std::cos(kTwoPi * x[i] / period));
-      }
-    q.mlp().forward(in.data(), 1, want.data());
-    EXPECT_NEAR(got[2 * n], want[0], 1e-5);
-    EXPECT_NEAR(got[2 * n + 1], want[1], 1e-5);
-  }
-  q.export_torchscript(path("qf.pt"));
-  Policy back = Policy::load(path("qf.pt"));
-  EXPECT_EQ(back.features(), q.features());
-  back.act(obs.data(), 5, back_got.data());
-  for (int i = 0; i < 10; ++i) EXPECT_NEAR(back_got[i], got[i], 1e-5);
 }
 
 // The switch margin is chosen on held-out S_a states: each margin's success rate equals a
 // by-hand replay with the exported q_ab (margin folded into Q(stay)) from those states.
-// With switch.fourier or switch.interval_features as well: the trainer's own input (its
-// choice) and the exported q_ab's (the replay) must then agree on those inputs too.
 TEST_F(TransitionTraining, SwitchMarginIsChosenOnHeldOutStarts) {
-  for (std::string fourier :
-       {"", "switch.fourier={inputs: [0, 3], periods: [0.5, 2]}", "switch.interval_features=true"}) {
-    SCOPED_TRACE(fourier);
-    std::vector<std::string> sets{"switch.validation_starts=4", "switch.margins=[10, -10, 0.05]"};
-    if (!fourier.empty()) sets.push_back(fourier);
-    CompositeRecipe r = tiny(sets);
-    const Transition& tr = r.meta.transitions()[0];
-    const Skill& b = r.skills[tr.to];
-    StartStates starts = collect_start_states(r, 0, 10, 1);
-    // The shipped pi_ab: balance itself falls from the walk's states, so every margin would fail.
-    Policy pi_ab = Policy::load(repo_path("assets/policies/walker/patrol/forward-balance/policy.pt"));
-    SwitchTrainer trainer(r.pipeline.switching, r, 0, starts, pi_ab, {}, 4);
-    trainer.run(24);
-    MarginChoice c = trainer.choose_margin();
-    ASSERT_EQ(c.margins, (std::vector<double>{-10, 0.05, 10}));
-    // -10 hands over at once (Without TP), 10 at the interval's end (With TP): these differ.
-    EXPECT_LT(c.success.front(), c.success.back());
-    auto env = r.make_env();
-    TransitionController after(r.skills, r.meta, {}, SwitchRule::IntervalEnd);
-    std::vector<float> obs(r.spec.obs_dim), act(r.spec.act_dim), q(2);
-    std::vector<double> f(r.spec.feature_names.size()), state;
-    const Policy plain = trainer.q_function();
-    const int features = fourier == "switch.interval_features=true" ? int(f.size()) : 0;
-    ASSERT_EQ(plain.obs_dim(), r.spec.obs_dim + features);
-    const std::vector<float> x(plain.obs_dim(), 0.3f);
-    for (size_t m = 0; m < c.margins.size(); ++m) {
-      Policy q_ab = trainer.q_function(c.margins[m]);
-      std::vector<float> q0(2);
-      q_ab.act(x.data(), 1, q.data());
-      plain.act(x.data(), 1, q0.data());
-      EXPECT_NEAR(q[0] - q0[0], c.margins[m], 1e-4);
-      EXPECT_EQ(q[1], q0[1]);
-      int succeeded = 0;
-      for (int i = 6; i < 10; ++i) {
-        starts.state(i, state);
-        env->restore_state(state, obs.data());
+  CompositeRecipe r = tiny({"switch.validation_starts=4", "switch.margins=[10, -10, 0.05]"});
+  const Transition& tr = r.meta.transitions()[0];
+  const Skill& b = r.skills[tr.to];
+  StartStates starts = collect_start_states(r, 0, 10, 1);
+  // The shipped pi_ab: balance itself falls from the walk's states, so every margin would fail.
+  Policy pi_ab = Policy::load(repo_path("assets/policies/walker/patrol/forward-balance/policy.pt"));
+  SwitchTrainer trainer = switch_trainer(r, 0, starts, pi_ab, 4);
+  trainer.run(24);
+  const int64_t trained_steps = trainer.env_steps();
+  MarginChoice c = trainer.choose_margin();
+  EXPECT_GT(trainer.env_steps(), trained_steps) << "the held-out runs' steps are the stage's too";
+  ASSERT_EQ(c.margins, (std::vector<double>{-10, 0.05, 10}));
+  // -10 hands over at once (Without TP), 10 at the interval's end (With TP): these differ.
+  EXPECT_LT(c.success.front(), c.success.back());
+  auto env = r.make_env();
+  TransitionController after(r.skills, r.meta, {}, SwitchRule::IntervalEnd);
+  std::vector<float> obs(r.spec.obs_dim), act(r.spec.act_dim), q(2), q0(2);
+  std::vector<double> f(r.spec.feature_names.size()), state;
+  const Policy plain = trainer.q_function();
+  ASSERT_EQ(plain.obs_dim(), r.spec.obs_dim);
+  const std::vector<float> x(plain.obs_dim(), 0.3f);
+  for (size_t m = 0; m < c.margins.size(); ++m) {
+    Policy q_ab = trainer.q_function(c.margins[m]);
+    q_ab.act(x.data(), 1, q.data());
+    plain.act(x.data(), 1, q0.data());
+    EXPECT_NEAR(q[0] - q0[0], c.margins[m], 1e-4);
+    EXPECT_EQ(q[1], q0[1]);
+    int succeeded = 0;
+    for (int i = 6; i < 10; ++i) {
+      starts.state(i, state);
+      env->restore_state(state, obs.data());
+      bool fell = false;
+      for (;;) {
+        q_ab.act(obs.data(), 1, q.data());
+        if (q[1] > q[0]) break;  // switch
+        pi_ab.act(obs.data() + b.obs_begin, 1, act.data());
+        StepResult sr = env->step(act.data(), obs.data());
         env->features(f.data());
-        bool fell = false;
-        for (;;) {
-          std::vector<float> in(obs);
-          if (q_ab.obs_dim() > int(obs.size())) in.insert(in.end(), f.begin(), f.end());
-          ASSERT_EQ(q_ab.obs_dim(), int(in.size()));
-          q_ab.act(in.data(), 1, q.data());
-          if (q[1] > q[0]) break;  // switch
-          pi_ab.act(obs.data() + b.obs_begin, 1, act.data());
-          StepResult sr = env->step(act.data(), obs.data());
-          env->features(f.data());
-          if ((fell = sr.terminated)) break;
-          if (sr.truncated || !MetaController::holds(tr.when, f.data())) break;  // the forced switch
-        }
-        if (!fell) succeeded += run_subtask(*env, after, tr.to, obs.data(), 1, r.pipeline.switching.max_subtask_steps);
+        if ((fell = sr.terminated)) break;
+        if (sr.truncated || !MetaController::holds(tr.when, f.data())) break;  // the forced switch
       }
-      EXPECT_DOUBLE_EQ(c.success[m], succeeded / 4.0) << "margin " << c.margins[m];
+      if (!fell) succeeded += run_subtask(*env, after, tr.to, obs.data(), 1, r.pipeline.switching.max_subtask_steps);
     }
-    // The best held-out success, the larger margin on ties.
-    double best = *std::max_element(c.success.begin(), c.success.end());
-    size_t k = c.margins.size() - 1;
-    while (c.success[k] < best) --k;
-    EXPECT_EQ(c.margin, c.margins[k]);
-    if (!fourier.empty()) continue;
-    // (Once.) Holding out all of S_a leaves nothing to train on.
-    CompositeRecipe all = tiny({"switch.validation_starts=10"});
-    try {
-      SwitchTrainer(all.pipeline.switching, all, 0, starts, b.policy, {}, 4);
-      ADD_FAILURE() << "validation_starts = |S_a| was accepted";
-    } catch (const Error& e) {
-      EXPECT_EQ(std::string(e.what()),
-                "switch training: validation_starts (10) leaves none of S_a's 10 states to train on");
-    }
+    EXPECT_DOUBLE_EQ(c.success[m], succeeded / 4.0) << "margin " << c.margins[m];
+  }
+  // The best held-out success, the larger margin on ties.
+  double best = *std::max_element(c.success.begin(), c.success.end());
+  size_t k = c.margins.size() - 1;
+  while (c.success[k] < best) --k;
+  EXPECT_EQ(c.margin, c.margins[k]);
+  // Holding out all of S_a leaves nothing to train on.
+  CompositeRecipe all = tiny({"switch.validation_starts=10"});
+  try {
+    switch_trainer(all, 0, starts, b.policy, 4);
+    ADD_FAILURE() << "validation_starts = |S_a| was accepted";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "switch training: validation_starts (10) leaves none of S_a's 10 states to train on");
   }
 }
 

@@ -1,7 +1,6 @@
 // With TP and With TP + Q (hrl/transition_controller.h): pi_ab drives exactly while the
 // interval holds (or for its max_steps), a q_ab that always switches is Without TP action
-// for action, and a q_ab trained with switch.interval_features reads the task's features;
-// at a random hand-over point, pi_ab or pi_a drives to a point drawn uniformly.
+// for action; at a random hand-over point, pi_ab or pi_a drives to a point drawn uniformly.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -81,34 +80,6 @@ TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
     ASSERT_LT(tpq.transition(), 0);
     if (e1->step(a1.data(), o1.data()).done() | e2->step(a2.data(), o2.data()).done()) break;
   }
-  // switch.interval_features: a q_ab wider than the observation reads the task's features
-  // after it. This one, Q(stay) = 0.2 and Q(switch) = 0.01 since_turn, hands over at the
-  // interval's first state with since_turn > 20, where With TP's pi_ab drove on.
-  const int D = r.spec.obs_dim, F = int(f.size());
-  ASSERT_EQ(r.spec.feature_names[1], "since_turn");
-  ASSERT_GT(driven, 25) << "With TP's pi_ab must drive past since_turn 20 for this check";
-  torch::Tensor w = torch::zeros({2, D + F});
-  w[1][D + 1] = 1.0f;
-  std::vector<float> inv_std(D + F, 1.0f);
-  inv_std[D + 1] = 0.01f;
-  art[0].q = Policy(EigenMlp({w}, {torch::tensor({0.2f, 0.0f})}, Activation::Relu), std::vector<float>(D + F, 0.0f),
-                    inv_std, 5.0f, {-1e9f, -1e9f}, {1e9f, 1e9f});
-  TransitionController by_time(r.skills, r.meta, art, SwitchRule::QNetwork);
-  for (uint64_t seed = 0;; ++seed) {  // With TP's episode
-    env->reset(seed, obs.data());
-    by_time.reset(*env, obs.data(), 0);
-    if (by_time.skill() == tr.from) break;
-  }
-  int handed_at = -1;
-  bool begun = false;
-  for (int t = 0; t < 300 && handed_at < 0; ++t) {
-    by_time.act(*env, obs.data(), act.data());
-    env->features(f.data());
-    if (by_time.transition() >= 0) begun = true;
-    else if (begun) handed_at = int(f[1]);
-    if (env->step(act.data(), obs.data()).done()) break;
-  }
-  EXPECT_EQ(handed_at, 21);
 }
 
 // eval.handover_point: random, the reference code's protocol. In each episode With TP's

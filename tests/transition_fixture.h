@@ -12,6 +12,7 @@
 
 #include "core/rng.h"
 #include "hrl/composite_recipe.h"
+#include "hrl/switch_training.h"
 #include "tests/temp_dir.h"
 #include "tests/tiny_patrol.h"
 
@@ -27,6 +28,15 @@ class TransitionTraining : public TempDirTest {
     return CompositeRecipe::load(file, sets);
   }
 };
+
+// Switch training on transition t of a recipe, from `starts`, with no other transition
+// policy trained (hrl/switch_training.h).
+inline SwitchTrainer switch_trainer(const CompositeRecipe& r, int t, StartStates starts, Policy pi_ab, uint64_t seed) {
+  const SwitchConfig& c = r.pipeline.switching;
+  return SwitchTrainer(c, SwitchInterval(r.make_env, r.skills, r.meta, t, std::move(starts), std::move(pi_ab), {},
+                                         c.lookahead, c.max_subtask_steps),
+                       seed);
+}
 
 inline std::vector<float> random_obs(int n, int d, uint64_t seed) {
   Rng rng(seed);

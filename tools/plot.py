@@ -11,6 +11,11 @@
       The methods' mean success counts (+- std) beside the paper's (tools/paper_results.json),
       for a table written by `segue report`. Default output RESULTS.png.
 
+  tools/plot.py diagnose DIAGNOSIS.json --out FILE.png
+      `segue diagnose --plot`: per transition the share of hand-overs after which pi_b
+      succeeds (at the interval's start, at its end, where q_ab switches, at the best point
+      in hindsight), and how the method's evaluation episodes ended.
+
   tools/plot.py montage FRAME.png ... --out FILE.png [--titles a,b,...]
       Frames from `segue render --frames` side by side, one per panel.
 
@@ -28,8 +33,12 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# The most a task's success count can be (docs/reference/tasks.md#episode-limits).
+MAXIMA = {"repetitive_picking": 5, "repetitive_catching": 5, "serve": 1, "patrol": 5, "hurdle": 5,
+          "obstacle_course": 5}
 METHODS = [("single", "Single"), ("without-tp", "Without TP"), ("tp", "With TP"),
            ("lee", "Lee et al. 2019"), ("tp+q", "With TP + Q")]
 
@@ -59,6 +68,15 @@ def column(rows, name):
     return out
 
 
+def tidy_axes(axes, rates):
+    """Readable step ticks (a few, in scientific notation) on every axis; rates in [0, 1]."""
+    for ax in axes:
+        ax.xaxis.set_major_locator(MaxNLocator(5))
+        ax.ticklabel_format(axis="x", style="sci", scilimits=(0, 0))
+    for ax in rates:
+        ax.set_ylim(-0.03, 1.03)
+
+
 def skill_curves(run_dir, out):
     rows = read_csv(os.path.join(run_dir, "metrics.csv"))
     for needed in ("global_step", "episode_return", "success_rate", "entropy"):
@@ -85,6 +103,7 @@ def skill_curves(run_dir, out):
         offset = max(offset, max(steps))
     if any(stages):
         axes[0].legend(fontsize=7)
+    tidy_axes(axes, [axes[1]])
     fig.suptitle(os.path.basename(os.path.normpath(run_dir)))
     fig.tight_layout()
     fig.savefig(out, dpi=100)
@@ -104,6 +123,7 @@ def transition_curves(run_dir, files, out):
         ax.set_title(title)
         ax.set_xlabel("environment steps")
         ax.legend(fontsize=7)
+    tidy_axes(axes, [axes[0], axes[2]])
     fig.suptitle(os.path.basename(os.path.normpath(run_dir)) + ": transition policies (AIRL)")
     fig.tight_layout()
     fig.savefig(out, dpi=100)
@@ -119,20 +139,69 @@ def methods_chart(results_path, out):
     names = [(k, label) for k, label in METHODS if k in ours or k in paper]
     if not names:
         raise InputError(f"{results_path}: no method of the paper in it")
-    fig, ax = plt.subplots(figsize=(8, 3.8))
+    fig, ax = plt.subplots(figsize=(8, 4.2))
     width = 0.38
     xs = range(len(names))
+    top = MAXIMA.get(task)
+
+    def whiskers(means, stds):  # a count lies in [0, maximum]: the whiskers stop there
+        low = [min(s, m) if not math.isnan(m) else 0 for m, s in zip(means, stds)]
+        high = [min(s, top - m) if top and not math.isnan(m) else s for m, s in zip(means, stds)]
+        return [low, high]
+
     mean = [ours.get(k, {}).get("mean", math.nan) for k, _ in names]
     std = [ours.get(k, {}).get("std", 0.0) for k, _ in names]
-    ax.bar([x - width / 2 for x in xs], mean, width, yerr=std, capsize=3, label="Segue", color="#0072B2")
+    ax.bar([x - width / 2 for x in xs], mean, width, yerr=whiskers(mean, std), capsize=3, label="Segue",
+           color="#0072B2")
     pm = [paper.get(k, [math.nan, 0])[0] for k, _ in names]
     ps = [paper.get(k, [math.nan, 0])[1] for k, _ in names]
-    ax.bar([x + width / 2 for x in xs], pm, width, yerr=ps, capsize=3, label="paper", color="#BBBBBB")
+    ax.bar([x + width / 2 for x in xs], pm, width, yerr=whiskers(pm, ps), capsize=3, label="paper", color="#BBBBBB")
     ax.set_xticks(list(xs))
     ax.set_xticklabels([label for _, label in names])
     ax.set_ylabel("success count")
-    ax.set_title(task.replace("_", " "))
+    if top:
+        ax.axhline(top, color="#666666", linewidth=0.8, linestyle=":")
+        ax.set_ylim(0, top * 1.25)
+    ax.set_title(task.replace("_", " ").capitalize())
     ax.legend()
+    episodes = {ours[k].get("episodes") for k, _ in names if k in ours}
+    seeds = {len(ours[k].get("seeds", [])) for k, _ in names if k in ours}
+    fig.text(0.01, 0.01, f"Bars: mean success count over {'/'.join(map(str, sorted(episodes)))} episodes x "
+             f"{'/'.join(map(str, sorted(seeds)))} seeds; whiskers: one standard deviation over the episodes,\n"
+             f"cut at 0 and the maximum" + (f"; dotted line: the maximum, {top}." if top else "."), fontsize=8)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
+    fig.savefig(out, dpi=100)
+
+
+def diagnosis_chart(path, out):
+    try:
+        d = json.load(open(path))
+        transitions, ends = d["transitions"], d["ends"]
+    except (OSError, ValueError, KeyError) as e:
+        raise InputError(f"{path}: cannot read a diagnosis ({e})")
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4), gridspec_kw={"width_ratios": [3, 2]})
+    kinds = [("at_start", "at the start (Without TP)", "#BBBBBB"), ("at_end", "at the end (With TP)", "#56B4E9"),
+             ("with_q", "where q_ab switches", "#0072B2"), ("oracle", "best point, in hindsight", "#E69F00")]
+    width = 0.8 / len(kinds)
+    xs = range(len(transitions))
+    for i, (key, label, colour) in enumerate(kinds):
+        values = [t[key] if t[key] is not None else math.nan for t in transitions]
+        left.bar([x - 0.4 + (i + 0.5) * width for x in xs], values, width, label=label, color=colour)
+    left.set_xticks(list(xs))
+    left.set_xticklabels([t["transition"] for t in transitions], rotation=20 if len(transitions) > 3 else 0)
+    left.set_ylim(0, 1.05)
+    left.set_ylabel("hand-overs after which pi_b succeeds")
+    left.set_title(f"hand-over, from {transitions[0]['starts'] if transitions else 0} states of S_a each")
+    left.legend(fontsize=8, loc="lower left")
+    top = ends[:8]
+    labels = [f"{e['in_control'] or '-'}, count {e['success_count']}, {e['how']}" for e in top]
+    right.barh(range(len(top)), [e["episodes"] for e in top], color="#0072B2")
+    right.set_yticks(range(len(top)))
+    right.set_yticklabels(labels, fontsize=8)
+    right.invert_yaxis()
+    right.set_xlabel("episodes")
+    right.set_title(f"{d['method']}: how its {d['episodes']} episodes ended")
+    fig.suptitle(f"{d['task'].replace('_', ' ')}: mean success count {d['success_count_mean']:.2f}")
     fig.tight_layout()
     fig.savefig(out, dpi=100)
 
@@ -144,13 +213,13 @@ def montage(frames, titles, out):
             images.append(plt.imread(f))
         except (OSError, ValueError, SyntaxError) as e:
             raise InputError(f"{f}: cannot read a picture ({e})")
-    fig, axes = plt.subplots(1, len(images), figsize=(3.2 * len(images), 2.6))
+    fig, axes = plt.subplots(1, len(images), figsize=(3.2 * len(images), 2.9))
     for i, (ax, img) in enumerate(zip(axes if len(images) > 1 else [axes], images)):
         ax.imshow(img)
         ax.axis("off")
         if i < len(titles):
             ax.set_title(titles[i])
-    fig.tight_layout()
+    fig.tight_layout(pad=0.8)
     fig.savefig(out, dpi=100)
 
 
@@ -163,6 +232,9 @@ def main():
     m = sub.add_parser("methods")
     m.add_argument("results")
     m.add_argument("--out")
+    dg = sub.add_parser("diagnose")
+    dg.add_argument("diagnosis")
+    dg.add_argument("--out", required=True)
     g = sub.add_parser("montage")
     g.add_argument("frames", nargs="+")
     g.add_argument("--out", required=True)
@@ -180,6 +252,9 @@ def main():
                 transition_curves(a.run_dir, transitions, out)
             else:
                 raise InputError(f"{a.run_dir}: neither metrics.csv nor */transition.csv")
+        elif a.what == "diagnose":
+            out = a.out
+            diagnosis_chart(a.diagnosis, out)
         elif a.what == "montage":
             out = a.out
             montage(a.frames, [t for t in a.titles.split(",") if t], out)

@@ -58,6 +58,7 @@ int eval_main(int argc, char** argv);
 int export_main(int argc, char** argv);
 int bench_main(int argc, char** argv);
 int report_main(int argc, char** argv);
+int diagnose_main(int argc, char** argv);
 int render_main(int argc, char** argv);
 int plot_main(int argc, char** argv);
 int keys_main(int argc, char** argv);

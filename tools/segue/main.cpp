@@ -23,6 +23,7 @@ const char* kUsage =
     "                     switch Q-networks, evaluation (resumes an interrupted run)\n"
     "  eval [POLICY]      evaluate a policy on a task, or a method on a composite task\n"
     "  report TASK        evaluate methods over seeds; write experiments/results/TASK.{md,json}\n"
+    "  diagnose TASK      where a method loses its episodes: hand-over rates, episode ends\n"
     "  export CKPT OUT    write a checkpoint's policy as TorchScript\n"
     "  render POLICY      render one episode of a policy to a video, headless\n"
     "  plot RUN_DIR       draw a run's learning curves (PNG)\n"
@@ -42,10 +43,11 @@ int dispatch(const std::string& cmd, int argc, char** argv) {
   if (cmd == "render") return segue::cli::render_main(argc, argv);
   if (cmd == "bench") return segue::cli::bench_main(argc, argv);
   if (cmd == "report") return segue::cli::report_main(argc, argv);
+  if (cmd == "diagnose") return segue::cli::diagnose_main(argc, argv);
   if (cmd == "plot") return segue::cli::plot_main(argc, argv);
   if (cmd == "keys") return segue::cli::keys_main(argc, argv);
   throw segue::Error("unknown command '" + cmd +
-                     "' (commands: train, run, eval, report, export, render, plot, keys, bench; see segue --help)");
+                     "' (commands: train, run, eval, report, diagnose, export, render, plot, keys, bench; see segue --help)");
 }
 
 // Takes `--nproc N` out of the command line; 0 if absent.

@@ -1,0 +1,176 @@
+#include "hrl/diagnosis.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <tuple>
+
+#include "core/assets.h"
+#include "hrl/collection.h"
+
+namespace segue {
+
+HandOverRates handover_rates(SwitchInterval& interval, const Policy* q_ab, int points) {
+  HandOverRates r;
+  r.starts = interval.starts();
+  std::vector<float> obs(interval.obs_dim()), q(2);
+  std::vector<std::vector<double>> path;  // the full state at each step of pi_ab's run
+  std::vector<int> judged;                // pi_b's outcome from each point: -1 not yet tried
+  int q_counted = 0;
+  double q_won = 0, q_progress = 0;
+  for (int i = 0; i < interval.starts(); ++i) {
+    interval.begin(i, obs.data());
+    path.clear();
+    int q_at = -1, steps = 0;
+    bool fell = false;
+    for (int t = 0;; ++t) {
+      path.emplace_back();
+      interval.save_state(path.back());
+      if (q_ab && q_at < 0) {
+        q_ab->act(obs.data(), 1, q.data());
+        if (q[1] > q[0]) q_at = t;
+      }
+      const SwitchInterval::Stay s = interval.stay(obs.data(), t, obs.data());
+      steps = t + 1;
+      if ((fell = s == SwitchInterval::Stay::Fell)) break;
+      if (s == SwitchInterval::Stay::Ended) {  // the forced switch's state
+        path.emplace_back();
+        interval.save_state(path.back());
+        break;
+      }
+    }
+    const int last = int(path.size()) - 1;
+    if (q_ab && q_at < 0 && !fell) q_at = last;  // the forced switch
+    judged.assign(path.size(), -1);
+    auto judge = [&](int k) {
+      if (judged[k] < 0) {
+        interval.restore_state(path[k], obs.data());
+        judged[k] = interval.hand_over(obs.data());
+      }
+      return judged[k] == 1;
+    };
+    r.at_start += judge(0);
+    if (!fell) r.at_end += judge(last);
+    bool won = false;
+    for (int j = 0; j < points && !won; ++j)
+      won |= judge(points == 1 ? 0 : int(std::lround(double(j) * last / (points - 1))));
+    if (q_at >= 0) {
+      const bool ok = judge(q_at);
+      q_won += ok;
+      won |= ok;
+      if (!fell) q_progress += double(q_at) / std::max(last, 1), ++q_counted;
+    }
+    r.oracle += won;
+    r.fell += fell;
+    r.interval_steps += steps;
+  }
+  const double n = std::max(1, r.starts);
+  r.at_start /= n, r.at_end /= n, r.oracle /= n, r.fell /= n, r.interval_steps /= n;
+  if (q_ab) r.with_q = q_won / n;
+  if (q_counted) r.q_progress = q_progress / q_counted;
+  return r;
+}
+
+std::vector<EpisodeEnd> episode_ends(const EvalResult& e) {
+  std::map<std::tuple<std::string, int, std::string>, int> counts;
+  for (size_t i = 0; i < e.returns.size(); ++i) {
+    const std::string how = e.successes[i] ? "success" : e.terminated[i] ? "terminated" : "time limit";
+    ++counts[{e.ended_under[i], int(std::lround(e.success_counts[i])), how}];
+  }
+  std::vector<EpisodeEnd> out;
+  for (const auto& [key, n] : counts) out.push_back({std::get<0>(key), std::get<1>(key), std::get<2>(key), n});
+  std::stable_sort(out.begin(), out.end(), [](const EpisodeEnd& a, const EpisodeEnd& b) { return a.episodes > b.episodes; });
+  return out;
+}
+
+Diagnosis diagnose(const CompositeRecipe& r, const std::string& method, int starts, int points, int episodes,
+                   uint64_t seed, int threads) {
+  if (r.transitions_dir.empty())
+    throw Error(r.file + ": key 'methods.transitions' is not set: no transition policies to diagnose");
+  Diagnosis d;
+  d.task = r.task, d.method = method;
+  const std::vector<TransitionArtefacts> trained =
+      load_transition_artefacts(r, repo_path(r.transitions_dir), "policy.pt", /*with_q=*/true);
+  std::vector<TransitionArtefacts> policies = trained;  // carry episodes on With TP (switch.lookahead > 1)
+  for (auto& a : policies) a.q.reset();
+  const SwitchConfig& sw = r.pipeline.switching;
+  for (int t = 0; t < int(trained.size()); ++t) {
+    if (!trained[t].policy)
+      throw Error(r.transitions_dir + "/" + r.transition_name(t) + ": no policy.pt (pi_ab) to diagnose");
+    StartStates s = collect_start_states(r, t, starts, mix_seed(seed, t), trained, kStartStateEpisodes, nullptr, threads);
+    SwitchInterval interval(r.make_env, r.skills, r.meta, t, std::move(s), *trained[t].policy, policies, sw.lookahead,
+                            sw.max_subtask_steps);
+    HandOverRates h = handover_rates(interval, trained[t].q ? &*trained[t].q : nullptr, points);
+    h.transition = r.transition_name(t);
+    d.transitions.push_back(h);
+  }
+  EvalResult all;
+  const ControllerFactory controllers = method_controllers(r, method);
+  for (int s : r.eval_seeds) all.append(evaluate(r.make_env, controllers, episodes, uint64_t(s), threads));
+  d.episodes = int(all.returns.size());
+  d.success_count_mean = summarize(all.success_counts).mean;
+  d.ends = episode_ends(all);
+  return d;
+}
+
+namespace {
+std::string num(double x, int digits = 3) {
+  if (x < 0) return "null";
+  std::ostringstream o;
+  o.precision(digits);
+  o << std::fixed << x;
+  return o.str();
+}
+}  // namespace
+
+std::string diagnosis_text(const Diagnosis& d) {
+  std::ostringstream o;
+  char line[256];
+  o << d.task << ": hand-overs from " << (d.transitions.empty() ? 0 : d.transitions[0].starts)
+    << " states of S_a per transition, pi_b judged as in switch training (share that succeed)\n";
+  std::snprintf(line, sizeof line, "  %-22s %9s %8s %10s %11s %11s %10s %9s\n", "transition", "at start", "at end",
+                "with q_ab", "best point", "pi_ab fell", "q_ab at", "interval");
+  o << line;
+  for (const HandOverRates& h : d.transitions) {
+    std::snprintf(line, sizeof line, "  %-22s %9.2f %8.2f %10s %11.2f %11.2f %10s %6.0f st\n", h.transition.c_str(),
+                  h.at_start, h.at_end, h.with_q < 0 ? "-" : num(h.with_q, 2).c_str(), h.oracle, h.fell,
+                  h.q_progress < 0 ? "-" : num(h.q_progress, 2).c_str(), h.interval_steps);
+    o << line;
+  }
+  o << "  (q_ab at: where q_ab hands over, 0 at the interval's start, 1 at its end)\n";
+  std::snprintf(line, sizeof line, "%s's %d evaluation episodes (mean success count %.2f) ended:\n", d.method.c_str(),
+                d.episodes, d.success_count_mean);
+  o << line;
+  std::snprintf(line, sizeof line, "  %8s  %-22s %5s  %s\n", "episodes", "in control", "count", "how");
+  o << line;
+  for (const EpisodeEnd& e : d.ends) {
+    std::snprintf(line, sizeof line, "  %8d  %-22s %5d  %s\n", e.episodes, e.in_control.empty() ? "-" : e.in_control.c_str(),
+                  e.success_count, e.how.c_str());
+    o << line;
+  }
+  return o.str();
+}
+
+std::string diagnosis_json(const Diagnosis& d) {
+  std::ostringstream o;
+  o << "{\"task\": \"" << d.task << "\", \"method\": \"" << d.method << "\", \"transitions\": [";
+  for (size_t i = 0; i < d.transitions.size(); ++i) {
+    const HandOverRates& h = d.transitions[i];
+    o << (i ? ", " : "") << "{\"transition\": \"" << h.transition << "\", \"starts\": " << h.starts
+      << ", \"at_start\": " << num(h.at_start) << ", \"at_end\": " << num(h.at_end) << ", \"with_q\": " << num(h.with_q)
+      << ", \"oracle\": " << num(h.oracle) << ", \"pi_ab_fell\": " << num(h.fell)
+      << ", \"q_progress\": " << num(h.q_progress) << ", \"interval_steps\": " << num(h.interval_steps, 1) << "}";
+  }
+  o << "], \"episodes\": " << d.episodes << ", \"success_count_mean\": " << num(d.success_count_mean)
+    << ", \"ends\": [";
+  for (size_t i = 0; i < d.ends.size(); ++i) {
+    const EpisodeEnd& e = d.ends[i];
+    o << (i ? ", " : "") << "{\"in_control\": \"" << e.in_control << "\", \"success_count\": " << e.success_count
+      << ", \"how\": \"" << e.how << "\", \"episodes\": " << e.episodes << "}";
+  }
+  o << "]}";
+  return o.str();
+}
+
+}  // namespace segue
