@@ -118,13 +118,6 @@ std::vector<float> EigenMlp::parameters() const {
   return theta;
 }
 
-std::vector<size_t> EigenMlp::input_weight_indices(int begin, int end) const {
-  std::vector<size_t> idx;
-  for (int r = 0; r < int(weights_.front().rows()); ++r)
-    for (int j = begin; j < end; ++j) idx.push_back(size_t(r) * in_dim() + j);
-  return idx;
-}
-
 void EigenMlp::set_parameters(const std::vector<float>& theta) {
   if (theta.size() != parameter_count())
     throw Error("network has " + std::to_string(parameter_count()) + " parameters, got " +

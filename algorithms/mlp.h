@@ -50,13 +50,10 @@ class EigenMlp {
   Activation activation() const { return act_; }
   const std::vector<RowMatrix>& weights() const { return weights_; }
   const std::vector<Eigen::RowVectorXf>& biases() const { return biases_; }
-  // Every weight and bias as one vector, layer by layer (W_i row-major, then b_i): the
-  // search space of a parameter-space method (evolution strategies).
+  // Every weight and bias as one vector, layer by layer (W_i row-major, then b_i).
   size_t parameter_count() const;
   std::vector<float> parameters() const;
   void set_parameters(const std::vector<float>& theta);  // throws segue::Error on a size mismatch
-  // Where, in parameters(), the first layer's weights from inputs [begin, end) sit.
-  std::vector<size_t> input_weight_indices(int begin, int end) const;
 
  private:
   std::vector<RowMatrix> weights_;  // [out, in]

@@ -17,7 +17,6 @@ void OnPolicyConfig::read_rollout(const Section& s) {
   gamma = s.get("gamma", gamma, Range::open_closed(0, 1));
   lambda = s.get("lambda", lambda, Range::closed(0, 1));
   min_log_std = s.get("min_log_std", min_log_std, Range::any());
-  noise_repeat = s.get("noise_repeat", noise_repeat, Range::positive());
   normalize_reward = s.get("normalize_reward", normalize_reward);
   obs_clip = s.get("obs_clip", obs_clip, Range::positive());
 }
@@ -40,8 +39,6 @@ OnPolicyLearner::OnPolicyLearner(std::string name, const OnPolicyConfig& config,
   buf_.resize(rollout_cfg_.steps_per_env, envs.size(), net.obs_dim, net.act_dim, net.in_dim());
   running_return_.assign(envs.size(), 0.0);
   mean_.resize(size_t(envs.size()) * net.act_dim);
-  noise_.resize(size_t(envs.size()) * net.act_dim);
-  noise_age_.assign(envs.size(), 0);
   env_rng_.resize(envs.size());
   return_samples_.resize(size_t(rollout_cfg_.steps_per_env) * envs.size());
   envs_.reset(mix_seed(seed, 0));
@@ -117,10 +114,7 @@ void OnPolicyLearner::sample_actions(int t) {
   for (int i = 0; i < N; ++i) {
     float* a = act + size_t(i) * A;
     const float* mu = &mean_[size_t(i) * A];
-    float* eps = &noise_[size_t(i) * A];
-    if (noise_age_[i]++ % rollout_cfg_.noise_repeat == 0)
-      for (int j = 0; j < A; ++j) eps[j] = static_cast<float>(env_rng_[i].normal());
-    for (int j = 0; j < A; ++j) a[j] = mu[j] + std::exp(log_std_[j]) * eps[j];
+    for (int j = 0; j < A; ++j) a[j] = mu[j] + std::exp(log_std_[j]) * static_cast<float>(env_rng_[i].normal());
     buf_.log_probs[size_t(t) * N + i] = static_cast<float>(gaussian_log_prob(a, mu, log_std_.data(), A));
   }
 }
@@ -144,7 +138,6 @@ void OnPolicyLearner::collect_rollout(IterationStats& stats) {
                   buf_.next_raw_obs_at(t) + size_t(i) * D);
       buf_.raw_rewards[k] = envs_.reward()[i];
       buf_.dones[k] = envs_.terminated()[i] || envs_.truncated()[i];
-      if (buf_.dones[k]) noise_age_[i] = 0;
       if (envs_.truncated()[i] && !envs_.terminated()[i]) {
         buf_.truncated_index.push_back(static_cast<int>(k));
         buf_.truncated_obs.resize(buf_.truncated_obs.size() + I);

@@ -36,11 +36,6 @@ struct OnPolicyConfig {
   // A floor under the policy's log std, kept after every update: a continued run may need
   // exploration held open (PPO's entropy bonus did not do it at these scales).
   double min_log_std = -20.0;       // -20: no floor
-  // Exploration noise held for this many steps before it is redrawn (as gSDE redraws its
-  // noise every n steps; Raffin et al. 2022). Independent noise each step averages out
-  // over a stance, so a gait's step length is never explored; noise held over a push-off
-  // changes it. Each action's marginal is still N(mu, sigma), which the update uses.
-  int noise_repeat = 1;
   bool normalize_reward = true;     // scale rewards by the std of the discounted return
   double obs_clip = 10.0;           // normalised observations are clipped to +-obs_clip
 
@@ -164,8 +159,6 @@ class OnPolicyLearner : public Learner {
   std::vector<float> return_samples_;  // the discounted returns of a rollout, for return_rms_
   std::vector<double> running_return_;  // discounted return per env, for reward scaling
   std::vector<float> mean_, log_std_;
-  std::vector<float> noise_;       // the standard normal draw each env's action adds [N, A]
-  std::vector<int> noise_age_;     // steps since that draw, reset when an episode ends
   RewardHook reward_hook_;
   double wall_seconds_ = 0.0;
 };

@@ -1,6 +1,6 @@
 // OnPolicyLearner's checkpoint: everything an exact resume needs (networks, optimiser,
-// normalisers, counters, the episodes in flight with their action noise), one file
-// written atomically, shared by PPO and TRPO.
+// normalisers, counters, the episodes in flight), one file written atomically, shared by
+// PPO and TRPO.
 #include <sstream>
 
 #include "algorithms/on_policy.h"
@@ -34,35 +34,28 @@ ObsFeatures read_features(torch::serialize::InputArchive& ar) {
 
 }  // namespace
 
-// The environments' episodes in flight with the trainer's per-environment state (action
-// noise, its age, the discounted return), as one rank holds them or as a checkpoint does.
+// The environments' episodes in flight with the trainer's per-environment state (the
+// discounted return), as one rank holds them or as a checkpoint does.
 struct OnPolicyLearner::InFlight {
   std::vector<double> state, running_return;
   std::string rngs;
-  std::vector<float> noise;
-  std::vector<int64_t> noise_age;
 
   void append(const InFlight& o) {
     state.insert(state.end(), o.state.begin(), o.state.end());
     rngs += o.rngs;
-    noise.insert(noise.end(), o.noise.begin(), o.noise.end());
-    noise_age.insert(noise_age.end(), o.noise_age.begin(), o.noise_age.end());
     running_return.insert(running_return.end(), o.running_return.begin(), o.running_return.end());
   }
   void write(torch::serialize::OutputArchive& ar) const {
     ar.write("episodes_state", torch::tensor(state, torch::kFloat64));
     ar.write("episodes_rng", text_tensor(rngs));
-    ar.write("episodes_noise", torch::tensor(noise));
-    ar.write("episodes_noise_age", torch::tensor(noise_age));
     ar.write("episodes_running_return", torch::tensor(running_return, torch::kFloat64));
   }
   bool read(torch::serialize::InputArchive& ar) {
-    torch::Tensor s, r, n, a, ret;
-    if (!(ar.try_read("episodes_state", s) && ar.try_read("episodes_rng", r) && ar.try_read("episodes_noise", n) &&
-          ar.try_read("episodes_noise_age", a) && ar.try_read("episodes_running_return", ret)))
+    torch::Tensor s, r, ret;
+    if (!(ar.try_read("episodes_state", s) && ar.try_read("episodes_rng", r) &&
+          ar.try_read("episodes_running_return", ret)))
       return false;
-    state = to_doubles(s), rngs = to_text(r), noise = to_floats(n), noise_age = to_int64s(a);
-    running_return = to_doubles(ret);
+    state = to_doubles(s), rngs = to_text(r), running_return = to_doubles(ret);
     return true;
   }
   std::string bytes() const {
@@ -105,8 +98,6 @@ void OnPolicyLearner::save(const std::string& path, const std::string& note, con
   InFlight mine;
   const bool saved = envs_.save_episodes(mine.state, mine.rngs);
   if (!group_.any(!saved)) {
-    mine.noise = noise_;
-    mine.noise_age.assign(noise_age_.begin(), noise_age_.end());
     mine.running_return = running_return_;
     InFlight all;
     for (const std::string& part : group_.gather(group_.single() ? std::string() : mine.bytes()))
@@ -146,15 +137,13 @@ void OnPolicyLearner::load(const std::string& path, const ArchiveReader& extra, 
     throw Error(path + ": unreadable checkpoint: " + what.substr(0, what.find('\n')));
   }
   refresh_inference_copy();
-  const int A = buf_.act_dim, first = envs_.first_index(), N = envs_.size();
-  if (in_flight && int64_t(saved.noise.size()) == global_envs_ * A) {
+  const int first = envs_.first_index(), N = envs_.size();
+  if (in_flight && int64_t(saved.running_return.size()) == global_envs_) {
     try {
       std::vector<double> state;
       std::string rngs;
       VectorEnv::slice_episodes(saved.state, saved.rngs, first, N, state, rngs);
       envs_.restore_episodes(state, rngs);
-      noise_.assign(saved.noise.begin() + size_t(first) * A, saved.noise.begin() + size_t(first + N) * A);
-      noise_age_.assign(saved.noise_age.begin() + first, saved.noise_age.begin() + first + N);
       running_return_.assign(saved.running_return.begin() + first, saved.running_return.begin() + first + N);
       return;
     } catch (const Error& e) {

@@ -1,5 +1,5 @@
 #pragma once
-// The console progress line: steps (or another unit: generations), rate, recent return, ETA. Redrawn in place on a
+// The console progress line: steps (or another unit: episodes), rate, recent return, ETA. Redrawn in place on a
 // terminal, printed as plain lines (at most every few seconds) into logs.
 //
 // A job of several parts (`segue run`: collection, training and evaluation per transition; a curriculum's

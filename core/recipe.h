@@ -112,7 +112,7 @@ class Recipe {
   void reject_unknown() const;
   // The values read so far, defaults included, as YAML text.
   std::string resolved_yaml() const;
-  // The keys among them that the recipe left to their defaults ("ppo.noise_repeat").
+  // The keys among them that the recipe left to their defaults ("ppo.min_log_std").
   const std::set<std::string>& defaulted_keys() const;
   // Each key read so far with its type and range ("transitions.0.max_steps": items by index).
   const std::map<std::string, KeyRule>& key_rules() const;

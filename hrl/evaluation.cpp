@@ -129,31 +129,6 @@ EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_co
       [&](int slot, int) -> Controller& { return *controllers[slot]; }, threads, progress);
 }
 
-std::vector<EvalResult> evaluate_population(const std::vector<Policy>& candidates, const EnvFactory& make_env,
-                                            int episodes, uint64_t seed, int threads) {
-  const int n = static_cast<int>(candidates.size());
-  std::vector<std::unique_ptr<PolicyController>> playing(slot_count(n * episodes));
-  EvalResult all = run_jobs(
-      make_env, n * episodes, [seed, episodes](int j) { return mix_seed(seed, j % episodes); },
-      [&](int slot, int j) -> Controller& {
-        playing[slot] = std::make_unique<PolicyController>(candidates[j / episodes]);
-        return *playing[slot];
-      },
-      threads);
-  std::vector<EvalResult> out(n);
-  for (int c = 0; c < n; ++c) {
-    EvalResult& r = out[c];
-    const auto b = size_t(c) * episodes, e = b + episodes;
-    r.returns.assign(all.returns.begin() + b, all.returns.begin() + e);
-    r.success_counts.assign(all.success_counts.begin() + b, all.success_counts.begin() + e);
-    r.lengths.assign(all.lengths.begin() + b, all.lengths.begin() + e);
-    r.successes.assign(all.successes.begin() + b, all.successes.begin() + e);
-    r.metric_names = all.metric_names;
-    for (const auto& m : all.metric_means) r.metric_means.emplace_back(m.begin() + b, m.begin() + e);
-  }
-  return out;
-}
-
 EvalResult evaluate_policy(const Policy& policy, const EnvFactory& make_env, int episodes, uint64_t seed,
                            int threads, const std::string& progress) {
   return evaluate(make_env, [&] { return std::make_unique<PolicyController>(policy); }, episodes, seed, threads,

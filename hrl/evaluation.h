@@ -36,10 +36,5 @@ EvalResult evaluate(const EnvFactory& make_env, const ControllerFactory& make_co
 // The common case: one deterministic policy.
 EvalResult evaluate_policy(const Policy& policy, const EnvFactory& make_env, int episodes, uint64_t seed,
                            int threads, const std::string& progress = "");
-// Several policies on the same `episodes` seeds (common random numbers: candidate c's
-// episode i starts from mix_seed(seed, i), as evaluate_policy's does), all episodes of
-// all candidates stepped side by side. One EvalResult per candidate, in order.
-std::vector<EvalResult> evaluate_population(const std::vector<Policy>& candidates, const EnvFactory& make_env,
-                                            int episodes, uint64_t seed, int threads);
 
 }  // namespace segue

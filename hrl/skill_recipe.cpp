@@ -31,12 +31,6 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   s.net.activation = parse_activation(pol.choice("activation", "tanh", {"tanh", "relu"}));
   s.net.init_log_std = pol.get("init_log_std", s.net.init_log_std, Range::any());
   s.net.ignore_obs = pol.get("ignore_obs", s.net.ignore_obs, Range::non_negative());
-  if (root.has("es")) {
-    s.es = EsConfig::read(root.sub("es"));
-    if (s.init_policy.empty()) throw root.error("es", "fine-tunes a trained policy: give init_policy too");
-    for (const char* key : {"ppo", "trpo", "sac", "learner", "policy"})
-      if (root.has(key)) throw root.error(key, "does not apply to an evolution-strategy run (key 'es')");
-  }
   s.learner = root.choice("learner", s.learner, {"ppo", "trpo", "sac"});
   for (const std::string other : {"ppo", "trpo", "sac"})
     if (other != s.learner && root.has(other))

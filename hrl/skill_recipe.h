@@ -22,8 +22,6 @@
 //   trpo: {...}               # with learner: trpo, see TrpoConfig (algorithms/trpo.h)
 //   sac: {...}                # with learner: sac, see SacConfig (algorithms/sac.h)
 //   eval: {episodes: 50, seed: 1000, reference_task: false}
-//   es: {...}                 # instead of ppo: fine-tune init_policy with evolution
-//                             # strategies (see EsConfig); policy and the learner do not apply
 //   lead_in: {policy: FILE, when: {curb_ahead: [3, 4]}, share: 0.5}  # optional: training
 //                             # episodes begin where another skill hands over (hrl/lead_in.h;
 //                             # read by segue train, as it needs a composing skill)
@@ -34,11 +32,9 @@
 #include <cmath>
 #include <functional>
 #include <memory>
-#include <optional>
 #include <string>
 
 #include "algorithms/actor_critic.h"
-#include "algorithms/evolution_strategy.h"
 #include "algorithms/ppo.h"
 #include "algorithms/sac.h"
 #include "algorithms/trpo.h"
@@ -79,7 +75,6 @@ struct SkillRecipe {
     return learner == "sac" ? sac.total_steps : learner == "trpo" ? trpo.total_steps : ppo.total_steps;
   }
   int num_envs() const { return learner == "sac" ? sac.num_envs : learner == "trpo" ? trpo.num_envs : ppo.num_envs; }
-  std::optional<EsConfig> es;  // set: the run is an evolution-strategy fine-tuning
 
   // Reads every key (then call recipe.reject_unknown()). `default_run_dir` is used when
   // the recipe names none.

@@ -2,7 +2,6 @@
 
 #include <spdlog/spdlog.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,7 +12,6 @@
 #include <set>
 #include <sstream>
 
-#include "algorithms/evolution_strategy.h"
 #include "core/assets.h"
 #include "core/distributed.h"
 #include "core/progress.h"
@@ -49,7 +47,8 @@ int finish_run(const Policy& policy, const SkillRecipe& s, const RunDir& dir, in
   return 0;
 }
 
-Policy load_init_policy(const SkillRecipe& s, const std::string& recipe_path, const EnvSpec& spec, bool prefix) {
+// init_policy, checked against the task: its observation may be a prefix of the task's.
+Policy load_init_policy(const SkillRecipe& s, const std::string& recipe_path, const EnvSpec& spec) {
   const std::string from = repo_path(s.init_policy);
   if (!std::filesystem::exists(from))
     throw Error(recipe_path + ": key 'init_policy': no such policy '" + s.init_policy + "'");
@@ -60,83 +59,8 @@ Policy load_init_policy(const SkillRecipe& s, const std::string& recipe_path, co
       throw Error(recipe_path + ": key 'init_policy': " + e.what());
     }
   }();
-  start.check_fits(spec, recipe_path + ": key 'init_policy': '" + s.init_policy + "'", prefix);
+  start.check_fits(spec, recipe_path + ": key 'init_policy': '" + s.init_policy + "'", /*prefix=*/true);
   return start;
-}
-
-// Evolution strategies from init_policy: a checkpoint (with the step and time counters),
-// policy.pt (theta, to evaluate mid-run) and a metrics row every generation.
-int train_es(const SkillRecipe& s, const Policy& start, const Recipe& recipe, const std::string& recipe_path,
-             RunDir& dir, int threads, const std::atomic<int>* stop) {
-  const EsConfig& cfg = *s.es;
-  const SearchedParameters space = [&] {
-    try {
-      return SearchedParameters(start, cfg.inputs);
-    } catch (const Error& e) {
-      throw Error(recipe_path + ": key 'es.inputs': " + e.what());
-    }
-  }();
-  EvolutionStrategy es(cfg, space.initial(), s.seed);
-  int64_t env_steps = 0;
-  double wall = 0.0;
-  if (dir.has_checkpoint()) {
-    std::vector<int64_t> counters = es.load(dir.checkpoint());
-    if (counters.size() == 2) env_steps = counters[0], wall = counters[1] / 1000.0;
-    if (es.generation() >= cfg.generations)
-      spdlog::info("{} is finished ({} generations, {} steps); re-evaluating its policy", dir.path(),
-                   es.generation(), env_steps);
-    else
-      spdlog::info("resuming {} from generation {} ({} steps)", dir.path(), es.generation(), env_steps);
-  } else {
-    spdlog::info("fine-tuning {} on {} in {} with evolution strategies: {} generations of {} candidates x {} "
-                 "episodes",
-                 s.init_policy, s.task, dir.path(), cfg.generations, 2 * cfg.pairs, cfg.episodes);
-  }
-  MetricsCsv csv(dir.file("metrics.csv"),
-                 {"generation", "global_step", "theta_success", "theta_return", "candidate_success_mean",
-                  "candidate_success_max", "candidate_return_mean", "gradient_norm", "wall_seconds"},
-                 es.generation());
-  Progress progress(s.task + " (es)", cfg.generations, es.generation(), "generation");
-  while (es.generation() < cfg.generations) {
-    auto t0 = std::chrono::steady_clock::now();
-    std::vector<Policy> candidates;
-    for (const auto& theta : es.ask()) candidates.push_back(space.policy_at(theta));
-    candidates.push_back(space.policy_at(es.theta()));  // the centre, for the log only
-    const uint64_t seed = es.episode_seed();
-    std::vector<EvalResult> results = evaluate_population(candidates, s.make_env, cfg.episodes, seed, threads);
-    std::vector<double> fitness;
-    double steps = 0, best = 0, mean_success = 0, mean_return = 0;
-    const double n = double(results.size() - 1);
-    for (size_t c = 0; c + 1 < results.size(); ++c) {
-      const double success = results[c].success_rate(), ret = summarize(results[c].returns).mean;
-      fitness.push_back(cfg.fitness == "success" ? success : ret);
-      best = std::max(best, success);
-      mean_success += success / n;
-      mean_return += ret / n;
-    }
-    for (const EvalResult& r : results)
-      for (double l : r.lengths) steps += l;
-    const EvalResult& centre = results.back();
-    const double centre_success = centre.success_rate(), centre_return = summarize(centre.returns).mean;
-    const double grad = es.tell(fitness);
-    env_steps += int64_t(steps);
-    wall += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    // The row before the checkpoint: a kill between the two repeats the generation, and the
-    // resumed run drops the row past its checkpoint, so no row is lost or doubled.
-    csv.write({double(es.generation()), double(env_steps), centre_success, centre_return, mean_success, best,
-               mean_return, grad, wall});
-    es.save(dir.checkpoint(), recipe.resolved_yaml(), {env_steps, int64_t(wall * 1000)});
-    space.policy_at(es.theta()).export_torchscript(dir.file("policy.pt"));
-    progress.update(es.generation(), centre_return, centre_success);
-    if (const int sig = signal_of(stop); sig && es.generation() < cfg.generations) {
-      progress.finish();
-      spdlog::warn("interrupted: checkpoint saved at generation {}; rerun the same command to resume",
-                   es.generation());
-      return 128 + sig;
-    }
-  }
-  progress.finish();
-  return finish_run(space.policy_at(es.theta()), s, dir, env_steps, wall, threads);
 }
 
 // A skill recipe read whole (its lead-in included), unknown keys refused.
@@ -325,12 +249,6 @@ int train_skill(const Recipe& recipe, const SkillRecipe& s, const std::atomic<in
   };
   const std::string checkpoint = s.run_dir + "/checkpoint.pt";
   const bool resume = group.any(group.leader() && std::filesystem::exists(checkpoint));
-  if (s.es) {
-    if (!group.single()) throw Error(recipe_path + ": key 'es': evolution strategies run on one process (drop --nproc)");
-    const Policy start = load_init_policy(s, recipe_path, s.make_env()->spec(), /*prefix=*/false);
-    make_dir();
-    return train_es(s, start, recipe, recipe_path, *dir, threads, stop);
-  }
   if (s.learner == "sac" && !group.single())
     throw Error(recipe_path + ": key 'learner': sac runs on one process (drop --nproc)");
   const Shard share = group.shard(s.num_envs(), recipe_path + ": key '" + s.learner + ".num_envs'");
@@ -362,7 +280,7 @@ int train_skill(const Recipe& recipe, const SkillRecipe& s, const std::atomic<in
                  learner->iteration(), learner->global_step(), total_steps);
   } else if (!s.init_policy.empty()) {
     const std::string key = recipe_path + ": key 'init_policy': '" + s.init_policy + "'";
-    Policy start = load_init_policy(s, recipe_path, envs.spec(), /*prefix=*/true);
+    Policy start = load_init_policy(s, recipe_path, envs.spec());
     try {
       on_policy->init_actor(start);
     } catch (const Error& e) {

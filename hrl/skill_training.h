@@ -1,10 +1,9 @@
 #pragma once
 // Skill training, what `segue train RECIPE` runs: a learner (PPO, TRPO or SAC, the recipe's
-// `learner:`) on one task, an evolution-strategy fine-tuning of a trained policy (an `es:`
-// section), or a curriculum (`stages:`, each stage a partial recipe laid over the rest of
-// the file). Every run keeps a run directory (recipe.yaml, metrics.csv, checkpoint.pt,
-// policy.pt, eval.json) that survives interruption: the same recipe run again resumes from
-// the last checkpoint, and a finished run is only evaluated again.
+// `learner:`) on one task, or a curriculum (`stages:`, each stage a partial recipe laid over
+// the rest of the file). Every run keeps a run directory (recipe.yaml, metrics.csv,
+// checkpoint.pt, policy.pt, eval.json) that survives interruption: the same recipe run again
+// resumes from the last checkpoint, and a finished run is only evaluated again.
 #include <atomic>
 #include <string>
 

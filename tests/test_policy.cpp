@@ -1,5 +1,5 @@
 // Inference paths agree: the Eigen mirror with LibTorch, the exported TorchScript with the
-// in-memory policy, and a checkpoint with both.
+// in-memory policy, and a checkpoint with both; the mirror's flat parameter view.
 #include <gtest/gtest.h>
 #include <torch/script.h>
 
@@ -36,6 +36,25 @@ TEST(EigenMlp, EqualsLibTorchForward) {
       EXPECT_NEAR(one[j], ref, 1e-6f * std::max(1.f, std::abs(ref)));
     }
   }
+}
+
+TEST(EigenMlp, FlatParametersRoundTripAndChangeTheOutput) {
+  torch::manual_seed(4);
+  EigenMlp mlp(make_mlp(5, {7}, 2, Activation::Tanh, 1.0), Activation::Tanh);
+  ASSERT_EQ(mlp.parameter_count(), size_t(5 * 7 + 7 + 7 * 2 + 2));
+  std::vector<float> theta = mlp.parameters();
+  EXPECT_EQ(theta[5 * 7], mlp.biases()[0][0]);      // W_0 row-major, then b_0
+  EXPECT_EQ(theta[5 * 7 + 7], mlp.weights()[1](0, 0));
+  const float x[5] = {0.1f, -0.2f, 0.3f, 0.0f, 1.0f};
+  float y0[2], y1[2];
+  mlp.forward(x, 1, y0);
+  theta.back() += 0.5f;  // the last bias: output 1 moves by exactly 0.5
+  mlp.set_parameters(theta);
+  mlp.forward(x, 1, y1);
+  EXPECT_FLOAT_EQ(y1[0], y0[0]);
+  EXPECT_NEAR(y1[1], y0[1] + 0.5f, 1e-6f);
+  EXPECT_EQ(mlp.parameters(), theta);
+  EXPECT_THROW(mlp.set_parameters(std::vector<float>(3)), Error);
 }
 
 class PolicyFiles : public TempDirTest {

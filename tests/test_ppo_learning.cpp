@@ -223,44 +223,4 @@ TEST(PpoLearning, MinLogStdHoldsExplorationOpen) {
   }
 }
 
-TEST(PpoLearning, NoiseRepeatHoldsEachEnvsDrawForThatManySteps) {
-  // The noise an action adds is (a - mu(s)) / sigma. With noise_repeat 4 it is redrawn at
-  // an env's steps 0, 4, 8, ... of each episode and equal in between; with 1, every step.
-  at::set_num_threads(1);
-  for (int repeat : {1, 4}) {
-    ShortWalker s;
-    s.cfg.noise_repeat = repeat;
-    s.cfg.steps_per_env = 64;
-    VectorEnv envs(s.make, 2, 1);
-    PPO ppo(s.cfg, s.spec, envs, 5);
-    ppo.set_log_std(0.0);
-    IterationStats stats;
-    ppo.collect_rollout(stats);
-    const RolloutBuffer& b = ppo.buffer();
-    torch::NoGradGuard no_grad;
-    auto mu = ppo.net()->mean(torch::from_blob(const_cast<float*>(b.obs.data()), {b.T * b.N, b.obs_dim}));
-    auto eps = torch::from_blob(const_cast<float*>(b.actions.data()), {b.T * b.N, b.act_dim}) - mu;
-    int held = 0, redrawn = 0;
-    for (int i = 0; i < b.N; ++i) {
-      int age = 0;
-      for (int t = 0; t < b.T; ++t) {
-        if (t > 0) {
-          double change = (eps[t * b.N + i] - eps[(t - 1) * b.N + i]).abs().max().item<double>();
-          if (age % repeat == 0) {
-            EXPECT_GT(change, 1e-3) << "env " << i << " step " << t;
-            ++redrawn;
-          } else {
-            EXPECT_LT(change, 1e-4) << "env " << i << " step " << t;
-            ++held;
-          }
-        }
-        age = b.dones[t * b.N + i] ? 0 : age + 1;
-      }
-    }
-    EXPECT_EQ(held + redrawn, 2 * 63);
-    if (repeat == 4) EXPECT_GE(held, 2 * 45);
-    else EXPECT_EQ(held, 0);
-  }
-}
-
 }  // namespace segue

@@ -37,10 +37,10 @@ TEST_F(RunDirTest, ResumesWithAnotherThreadCountButNotAnotherRecipe) {
 }
 
 TEST_F(RunDirTest, ResumesWhenTheCodeGainedAKeyTheRecipeLeavesAtItsDefault) {
-  // The run started before ppo.noise_repeat existed. Resuming with it at its default is
+  // The run started before ppo.min_log_std existed. Resuming with it at its default is
   // the same run, and the stored recipe gains the key; set explicitly, it is refused.
   const std::string old_recipe = "task: walker_jump\nppo:\n  lr: 0.0003\n  hidden: [32, 32]\n";
-  const std::string now = "task: walker_jump\nppo:\n  lr: 0.0003\n  hidden: [32, 32]\n  noise_repeat: 1\n";
+  const std::string now = "task: walker_jump\nppo:\n  lr: 0.0003\n  hidden: [32, 32]\n  min_log_std: -20\n";
   std::filesystem::remove_all(dir_);
   RunDir first(dir_.string(), old_recipe);
   auto refused = [&](const std::string& resolved, const std::set<std::string>& defaulted) {
@@ -52,14 +52,14 @@ TEST_F(RunDirTest, ResumesWhenTheCodeGainedAKeyTheRecipeLeavesAtItsDefault) {
     return std::string();
   };
   EXPECT_EQ(refused(now, {}), path("recipe.yaml") +
-            ": this run directory was started with a different recipe (key 'ppo.noise_repeat': absent there, 1 now); "
+            ": this run directory was started with a different recipe (key 'ppo.min_log_std': absent there, -20 now); "
             "choose another run_dir or remove the directory");
   EXPECT_NE(refused("task: walker_jump\nppo:\n  lr: 0.0003\n  hidden: [32, 64]\n", {}).find("key 'ppo.hidden.1': 32 there, 64 now"),
             std::string::npos);
   EXPECT_NE(refused("task: walker_jump\nppo:\n  lr: 0.0003\n", {}).find("key 'ppo.hidden.0': 32 there, absent now"),
             std::string::npos);
   EXPECT_EQ(read_file(path("recipe.yaml")), old_recipe);
-  EXPECT_EQ(refused(now, {"ppo.noise_repeat", "ppo.lr"}), "");
+  EXPECT_EQ(refused(now, {"ppo.min_log_std", "ppo.lr"}), "");
   EXPECT_EQ(read_file(path("recipe.yaml")), now);
   EXPECT_EQ(refused(now, {}), "");  // the rewritten recipe holds the key now
 }

@@ -8,7 +8,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$SECONDS
 phase() { echo "run_tests: $1 ($((SECONDS - start)) s in)"; }
-RELEASE_ONLY='^(Jaco\.PpoImprovesThePickReturn|PpoLearning\..*|Trpo\.Improves.*|Sac\.Improves.*|EvolutionStrategy\.Improves.*|KillSoak\..*|TsneTool|PlotTool)$'
+RELEASE_ONLY='^(Jaco\.PpoImprovesThePickReturn|PpoLearning\..*|Trpo\.Improves.*|Sac\.Improves.*|KillSoak\..*|TsneTool|PlotTool)$'
 bash tools/install_deps.sh
 phase "dependencies present"
 bash tools/build.sh

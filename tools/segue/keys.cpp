@@ -106,7 +106,7 @@ int keys_main(int argc, char** argv) {
       "(`hrl/skill_recipe.h`, `algorithms/on_policy.h`, `algorithms/ppo.h`, `algorithms/trpo.h`,\n`algorithms/sac.h`, `hrl/composite_recipe.h`, `hrl/pipeline_config.h`) and\n"
       "`docs/usage.md`.\n\n");
 
-  // Skill recipes: the plain keys, then those read only with es:, policy.fourier and lead_in.
+  // Skill recipes: the plain keys, then those read only with policy.fourier and lead_in.
   const std::string jump_policy = "assets/policies/walker/walker_forward.pt";
   Rows skill;
   auto add_skill = [&](const std::string& yaml) {
@@ -118,11 +118,10 @@ int keys_main(int argc, char** argv) {
   add_skill("{task: walker_forward, init_from: runs/x/checkpoint.pt, init_log_std: -1, restart_lr_schedule: true}");
   add_skill("{task: walker_jump, policy: {fourier: {inputs: [26], periods: [1.0]}}, lead_in: {policy: " + jump_policy +
             ", when: {curb_ahead: [3, 4]}}}");
-  add_skill("{task: walker_jump, init_policy: " + jump_policy + ", es: {}}");
   add_skill("{task: walker_forward, learner: trpo}");
   add_skill("{task: walker_forward, learner: sac}");
   std::printf("## Skill recipes (`segue train`)\n\n"
-              "`task` is required. `init_from`, `init_policy`, `es.*` and `lead_in.*` are optional; the values\n"
+              "`task` is required. `init_from`, `init_policy` and `lead_in.*` are optional; the values\n"
               "shown for them are examples. `learner` picks the section read: `ppo.*` (the default), `trpo.*` or `sac.*`. A recipe may also hold `stages:`, a list of partial recipes run in\n"
               "order (each with `name`, and `continue: checkpoint | policy`; see `experiments/primitives/walker_jump.yaml`).\n\n");
   table(skill, [](const std::string& k) { return !starts(k, "env."); });

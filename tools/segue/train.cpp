@@ -14,8 +14,7 @@ namespace {
 const Command kTrain{
     "train",
     "RECIPE [--set key=value ...]",
-    "Trains a skill with the recipe's learner (PPO, TRPO or SAC), or with an `es:` section\n"
-    "fine-tunes init_policy with evolution strategies. Writes the run directory\n"
+    "Trains a skill with the recipe's learner (PPO, TRPO or SAC). Writes the run directory\n"
     "(recipe.yaml, metrics.csv, checkpoint.pt, policy.pt, eval.json). Rerunning the same\n"
     "command after an interruption resumes from the last checkpoint; a finished run is\n"
     "only re-evaluated. A composite recipe (with skills:) is for 'segue run'.",
