@@ -64,7 +64,8 @@ class JacoEnv : public MujocoEnv {
   void unwind_arm();
 
   // Features (what transition intervals and expert windows are written in): steps (since
-  // the episode start), object_z; a task appends its own.
+  // the episode start), object_z; a task appends its own after these kArmFeatures.
+  static constexpr int kArmFeatures = 2;
   void features(double* out) const override;
 
  protected:

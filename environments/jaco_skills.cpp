@@ -20,8 +20,6 @@ PickRule::Config PickRule::Config::read(const Section& e) {
   c.hold_weight = e.get("hold_weight", c.hold_weight, Range::non_negative());
   c.hold_steps = e.get("hold_steps", c.hold_steps, Range::at_least(1));
   c.time_bonus = e.get("time_bonus", c.time_bonus, Range::non_negative());
-  c.center_weight = e.get("center_weight", c.center_weight, Range::non_negative());
-  c.push_weight = e.get("push_weight", c.push_weight, Range::non_negative());
   return c;
 }
 
@@ -37,20 +35,14 @@ void PickRule::begin(const JacoEnv& env) {
   Vec3 box = env.object_pos();
   s.target = {box[0], box[1], cfg.hold_height};
   s.prev_dist = env.hand_object_distance();
-  s.prev_box = box;
 }
 
 RuleStep PickRule::step(const JacoEnv& env, int t, int max_steps) {
   RuleStep r;
   const double d = env.hand_object_distance(), z = env.object_z();
   const bool hand = d < cfg.in_hand, air = z > cfg.in_air;
-  const Vec3 box = env.object_pos();
-  if (!s.picked) {
-    r.reward += cfg.guide_weight * (s.prev_dist - d) -
-                cfg.push_weight * std::hypot(box[0] - s.prev_box[0], box[1] - s.prev_box[1]);
-  }
+  if (!s.picked) r.reward += cfg.guide_weight * (s.prev_dist - d);
   s.prev_dist = d;
-  s.prev_box = box;
   if (hand && air) {
     s.picked = 1;
     const double gain = std::min(cfg.lift_cap, z) - s.pick_height;
@@ -58,7 +50,7 @@ RuleStep PickRule::step(const JacoEnv& env, int t, int max_steps) {
       r.reward += cfg.lift_weight * gain;
       s.pick_height = z;
     }
-    r.reward += cfg.hold_weight * (1 - distance(s.target, box)) - cfg.center_weight * d;
+    r.reward += cfg.hold_weight * (1 - distance(s.target, env.object_pos()));
     s.held += 1;
     if (s.held >= cfg.hold_steps) {
       r.success = true;
@@ -88,7 +80,7 @@ CatchRule::Config CatchRule::Config::read(const Section& e, const Vec3& hold_tar
   return c;
 }
 
-void CatchRule::place(JacoEnv& env) const { env.place_object(cfg.start, cfg.quat_noise, 0.0); }
+void CatchRule::place(JacoEnv& env, Rng&) const { env.place_object(cfg.start, cfg.quat_noise, 0.0); }
 
 void CatchRule::throw_box(JacoEnv& env, Rng& rng) const {
   Vec3 aim = cfg.aim;
@@ -229,7 +221,7 @@ void HitRule::begin(const JacoEnv& env) {
   s.prev_x = env.object_pos()[0];
 }
 
-RuleStep HitRule::step(const JacoEnv& env, double dt) {
+RuleStep HitRule::step(const JacoEnv& env) {
   RuleStep r;
   const Vec3 ball = env.object_pos();
   const double z = ball[2];
@@ -245,7 +237,7 @@ RuleStep HitRule::step(const JacoEnv& env, double dt) {
     }
   }
   if (s.hit) {
-    r.reward -= cfg.vx_cost * std::abs(ball[0] - s.prev_x) / dt;
+    r.reward -= cfg.vx_cost * std::abs(ball[0] - s.prev_x) / env.control_dt();
     const double to_target = distance(cfg.target, ball);
     s.closest = std::min(s.closest, to_target);
     r.reward += cfg.approach_weight * (s.prev_to_target - to_target);
@@ -266,7 +258,6 @@ RuleStep HitRule::step(const JacoEnv& env, double dt) {
   return r;
 }
 
-namespace {
 StepResult skill_result(double control, const RuleStep& rs) {
   StepResult r;
   r.reward = control + rs.reward;
@@ -275,35 +266,5 @@ StepResult skill_result(double control, const RuleStep& rs) {
   r.info.success_count = rs.success ? 1 : 0;
   return r;
 }
-}  // namespace
-
-template <> void JacoPick::place_task_object() { rule_.place(*this, rng_); }
-template <> void JacoPick::begin_task() { rule_.begin(*this); }
-template <> void JacoPick::after_random_steps() {}
-template <> StepResult JacoPick::score(const float* a) {
-  return skill_result(control_cost(a), rule_.step(*this, t_, spec_.max_episode_steps));
-}
-
-template <> void JacoCatch::place_task_object() { rule_.place(*this); }
-template <> void JacoCatch::begin_task() { rule_.begin(); }
-template <> void JacoCatch::after_random_steps() { rule_.throw_box(*this, rng_); }
-template <> StepResult JacoCatch::score(const float* a) { return skill_result(control_cost(a), rule_.step(*this)); }
-
-template <> void JacoToss::place_task_object() { rule_.place(*this, rng_); }
-template <> void JacoToss::begin_task() { rule_.begin(*this); }
-template <> void JacoToss::after_random_steps() {}
-template <> StepResult JacoToss::score(const float* a) { return skill_result(control_cost(a), rule_.step(*this)); }
-
-template <> void JacoHit::place_task_object() { rule_.place(*this, rng_); }
-template <> void JacoHit::begin_task() { rule_.begin(*this); }
-template <> void JacoHit::after_random_steps() {}
-template <> StepResult JacoHit::score(const float* a) {
-  return skill_result(control_cost(a), rule_.step(*this, control_dt()));
-}
-
-template class JacoSkill<PickRule>;
-template class JacoSkill<CatchRule>;
-template class JacoSkill<TossRule>;
-template class JacoSkill<HitRule>;
 
 }  // namespace segue

@@ -2,7 +2,14 @@
 // The arm's four sub-tasks (docs/reference/jaco.md#sub-tasks): pick, catch, toss, hit. Each
 // rule is a small struct (its settings, its bookkeeping, one step of scoring) so that the
 // composite tasks, which run the same rules in sequence or repeatedly, reuse them unchanged.
-#include <type_traits>
+// Every rule offers JacoSkill, which runs one alone, the same calls:
+//   place(env, rng)               the object for a new episode
+//   begin(env)                    fresh bookkeeping, before the random steps
+//   after_random_steps(env, rng)  what follows them (the catch's throw)
+//   step(env)                     one step's reward, success and failure
+//   feature_names(), write_features(out)  the features it adds to the arm's
+#include <string>
+#include <vector>
 
 #include "environments/jaco.h"
 
@@ -15,8 +22,15 @@ struct RuleStep {
   bool failed = false;
 };
 
+// The calls most rules need nothing for.
+struct ArmRule {
+  void after_random_steps(JacoEnv&, Rng&) const {}
+  static std::vector<std::string> feature_names() { return {}; }
+  void write_features(double*) const {}
+};
+
 // Pick: lift the box and hold it in the air for hold_steps steps.
-struct PickRule {
+struct PickRule : ArmRule {
   struct Config {
     double in_hand = 0.06, in_air = 0.05;
     Vec3 tile{0.5, 0.2, 0.03};   // the box starts at tile + (U(0, tile_size), U(0, tile_size), 0)
@@ -29,18 +43,11 @@ struct PickRule {
     double hold_weight = 2.0;    // 2 (1 - |target - box|) on each held step
     int hold_steps = 50;
     double time_bonus = 1.0;     // time_bonus (max_steps - t) at success
-    // Not in the reference (0 there): -center_weight |hand - box| on each held step, for a
-    // grasp deep in the hand rather than at the edge of in_hand, where the box slips out.
-    double center_weight = 0.0;
-    // Not in the reference (0 there): -push_weight |box's horizontal move| on each step
-    // before the pick, for an approach that does not knock the box out of reach.
-    double push_weight = 0.0;
     static Config read(const Section& env);
   };
   struct State {
     double prev_dist = 0, pick_height = 0, held = 0, picked = 0;
     Vec3 target{0, 0, 0};
-    Vec3 prev_box{0, 0, 0};
   };
   Config cfg;
   State s;
@@ -49,10 +56,12 @@ struct PickRule {
   void begin(const JacoEnv& env);
   // t: steps since the pick began; max_steps: its time limit.
   RuleStep step(const JacoEnv& env, int t, int max_steps);
+  // Alone, the pick's clock is the episode's.
+  RuleStep step(const JacoEnv& env) { return step(env, env.episode_step(), env.spec().max_episode_steps); }
 };
 
 // Catch: the box is thrown at the arm; hold it in the air for hold_steps steps (cumulative).
-struct CatchRule {
+struct CatchRule : ArmRule {
   struct Config {
     double in_hand = 0.06, in_air = 0.05, on_ground = 0.05;
     Vec3 start{0.0, 2.0, 1.5};
@@ -72,17 +81,19 @@ struct CatchRule {
   Config cfg;
   State s;
 
-  void place(JacoEnv& env) const;
+  void place(JacoEnv& env, Rng& rng) const;
   // Repetitive catching holds the next box at the start, at rest, until it is thrown.
   void pin_at_start(JacoEnv& env) const { env.pin_object(cfg.start); }
   void throw_box(JacoEnv& env, Rng& rng) const;
-  void begin() { s = State(); }
+  void begin(const JacoEnv&) { s = State(); }
+  // The box falls during the random steps, and is then thrown.
+  void after_random_steps(JacoEnv& env, Rng& rng) const { throw_box(env, rng); }
   RuleStep step(const JacoEnv& env);
 };
 
 // Toss: pick the ball up, throw it from below release_height so it peaks at apex_height,
 // and let it come back down within land_tolerance of (land_x, land_y).
-struct TossRule {
+struct TossRule : ArmRule {
   struct Config {
     double in_hand = 0.10, in_air = 0.07;
     Vec3 start{0.4, 0.3, 0.04};
@@ -121,7 +132,7 @@ struct TossRule {
 };
 
 // Hit: strike the falling ball at hit_height so that it flies to the target on the wall.
-struct HitRule {
+struct HitRule : ArmRule {
   struct Config {
     double hit_distance = 0.12, on_ground = 0.07;
     Vec3 start{0.4, 0.3, 2.0};
@@ -151,10 +162,16 @@ struct HitRule {
   // Moves the target geom to where the rule measures it (Serve, which places its own ball).
   void place_target(JacoEnv& env) const { env.move_geom("target", cfg.target); }
   void begin(const JacoEnv& env);
-  // dt: the control step, for the ball's x velocity by finite differences.
-  RuleStep step(const JacoEnv& env, double dt);
+  RuleStep step(const JacoEnv& env);
   bool hit() const { return s.hit != 0; }
+  // Feature hit: 1 after the hit, else 0.
+  static std::vector<std::string> feature_names() { return {"hit"}; }
+  void write_features(double* out) const { out[0] = s.hit; }
 };
+
+// A sub-task's step: the control cost and the rule's reward; it ends on the rule's success
+// or failure.
+StepResult skill_result(double control, const RuleStep& rs);
 
 // A sub-task: one rule on the arm, ended by its success or failure.
 template <class Rule>
@@ -164,19 +181,19 @@ class JacoSkill : public JacoEnv {
             const typename Rule::Config& rule)
       : JacoEnv(name, c, model, with_rotation) {
     rule_.cfg = rule;
-    if constexpr (std::is_same_v<Rule, HitRule>) spec_.feature_names.push_back("hit");  // 0 / 1
+    for (const auto& f : Rule::feature_names()) spec_.feature_names.push_back(f);
   }
   const Rule& rule() const { return rule_; }
   void features(double* out) const override {
     JacoEnv::features(out);
-    if constexpr (std::is_same_v<Rule, HitRule>) out[2] = rule_.s.hit;
+    rule_.write_features(out + kArmFeatures);
   }
 
  protected:
-  void place_task_object() override;
-  void begin_task() override;
-  void after_random_steps() override;
-  StepResult score(const float* action) override;
+  void place_task_object() override { rule_.place(*this, rng_); }
+  void begin_task() override { rule_.begin(*this); }
+  void after_random_steps() override { rule_.after_random_steps(*this, rng_); }
+  StepResult score(const float* action) override { return skill_result(control_cost(action), rule_.step(*this)); }
   void save_task_state(std::vector<double>& out) const override { append_state(out, rule_.s); }
   void restore_task_state(const double* in, size_t n) override { read_state(in, n, spec_.name, rule_.s); }
 

@@ -20,6 +20,15 @@ StepResult composite_result(double reward, bool failed, int successes, int goal)
 
 // ---- Repetitive picking up ----------------------------------------------------------------
 
+JacoRepetitivePick::Config JacoRepetitivePick::Config::read(const Section& env) {
+  Config k;
+  k.successes = env.get("successes", k.successes, Range::at_least(1));
+  k.pick_steps = env.get("pick_steps", k.pick_steps, Range::at_least(1));
+  k.unwind_arm = env.get("unwind_arm", k.unwind_arm);
+  k.pick = PickRule::Config::read(env);
+  return k;
+}
+
 JacoRepetitivePick::JacoRepetitivePick(const std::string& name, const JacoConfig& c, const Config& k)
     : JacoEnv(name, c, "jaco/jaco_box.xml", /*with_rotation=*/true), k_(k) {
   pick_.cfg = k.pick;
@@ -67,6 +76,16 @@ void JacoRepetitivePick::restore_task_state(const double* in, size_t n) {
 
 // ---- Repetitive catching ------------------------------------------------------------------
 
+JacoRepetitiveCatch::Config JacoRepetitiveCatch::Config::read(const Section& env) {
+  Config k;
+  k.successes = env.get("successes", k.successes, Range::at_least(1));
+  k.pin_steps = env.get("pin_steps", k.pin_steps, Range::non_negative());
+  k.fall_steps = env.get("fall_steps", k.fall_steps, Range::non_negative());
+  k.unwind_arm = env.get("unwind_arm", k.unwind_arm);
+  k.catching = CatchRule::Config::read(env, /*hold_target=*/{0.0, 0.2, 0.2});
+  return k;
+}
+
 JacoRepetitiveCatch::JacoRepetitiveCatch(const std::string& name, const JacoConfig& c, const Config& k)
     : JacoEnv(name, c, "jaco/jaco_box.xml", /*with_rotation=*/true), k_(k) {
   catch_.cfg = k.catching;
@@ -78,10 +97,10 @@ void JacoRepetitiveCatch::features(double* out) const {
   out[2] = n_.successes, out[3] = n_.since_success, out[4] = n_.since_throw, out[5] = n_.wait > 0 ? 1 : 0;
 }
 
-void JacoRepetitiveCatch::place_task_object() { catch_.place(*this); }
+void JacoRepetitiveCatch::place_task_object() { catch_.place(*this, rng_); }
 
 void JacoRepetitiveCatch::begin_task() {
-  catch_.begin();
+  catch_.begin(*this);
   n_ = Count();
   n_.since_success = kFar;
 }
@@ -111,7 +130,7 @@ StepResult JacoRepetitiveCatch::score(const float* action) {
     if (rs.success) {
       n_.successes += 1;
       n_.since_success = 0;
-      catch_.begin();
+      catch_.begin(*this);
       if (n_.successes < k_.successes) {
         catch_.pin_at_start(*this);
         if (k_.unwind_arm) unwind_arm();
@@ -129,6 +148,18 @@ void JacoRepetitiveCatch::restore_task_state(const double* in, size_t n) {
 }
 
 // ---- Serve --------------------------------------------------------------------------------
+
+// The toss's and the hit's rules read the same `start`, `start_noise` and `vel_noise`; Serve
+// places its ball by the toss's (on the ground).
+JacoServe::Config JacoServe::Config::read(const Section& env) {
+  Config k;
+  k.judge_height = env.get("judge_height", k.judge_height, Range::non_negative());
+  k.toss_bonus = env.get("toss_bonus", k.toss_bonus, Range::non_negative());
+  k.toss_tolerance = env.get("toss_tolerance", k.toss_tolerance, Range::non_negative());
+  k.toss = TossRule::Config::read(env);
+  k.hit = HitRule::Config::read(env);
+  return k;
+}
 
 JacoServe::JacoServe(const std::string& name, const JacoConfig& c, const Config& k)
     : JacoEnv(name, c, "jaco/jaco_ball.xml", /*with_rotation=*/false), k_(k) {
@@ -169,7 +200,7 @@ StepResult JacoServe::score(const float* action) {
   else n_.since_release = std::min(kFar, n_.since_release + 1);
   if (toss_.falling() && !failed) {
     if (!was_falling) hit_.begin(*this);  // the hit's clock (its x velocity) starts at the apex
-    RuleStep rs = hit_.step(*this, control_dt());
+    RuleStep rs = hit_.step(*this);
     reward += rs.reward;
     failed = rs.failed;
     success = rs.success;

@@ -19,6 +19,7 @@ class JacoRepetitivePick : public JacoEnv {
     int pick_steps = 200;  // the pick's own time limit (its time bonus counts down from it)
     bool unwind_arm = false;  // true: each success also unwinds the arm (JacoEnv::unwind_arm); the reference: no
     PickRule::Config pick;
+    static Config read(const Section& env);
   };
   JacoRepetitivePick(const std::string& name, const JacoConfig& c, const Config& k);
   void features(double* out) const override;
@@ -55,7 +56,8 @@ class JacoRepetitiveCatch : public JacoEnv {
     int pin_steps = 49;
     int fall_steps = 10;
     bool unwind_arm = false;  // true: each success also unwinds the arm (JacoEnv::unwind_arm); the reference: no
-    CatchRule::Config catching;
+    CatchRule::Config catching;  // its hold target is KeepCatch's, (0, 0.2, 0.2), not Catch's
+    static Config read(const Section& env);
   };
   JacoRepetitiveCatch(const std::string& name, const JacoConfig& c, const Config& k);
   void features(double* out) const override;
@@ -93,6 +95,7 @@ class JacoServe : public JacoEnv {
     double toss_tolerance = 0.1;
     TossRule::Config toss;
     HitRule::Config hit;
+    static Config read(const Section& env);
   };
   JacoServe(const std::string& name, const JacoConfig& c, const Config& k);
   void features(double* out) const override;

@@ -34,59 +34,18 @@ Factory walker_balance(const std::string& name, const Section& env) {
 }
 
 Factory walker_jump(const std::string& name, const Section& env) {
-  WalkerConfig w = WalkerConfig::read(env);
-  ObstacleConfig o = ObstacleConfig::read(env);
-  WalkerJump::Config j;
-  j.curb_x = env.get("curb_x", j.curb_x, Range::any());
-  j.curb_noise = env.get("curb_noise", j.curb_noise, Range::non_negative());
-  j.cross_bonus = env.get("cross_bonus", j.cross_bonus, Range::non_negative());
-  j.upward_weight = env.get("upward_weight", j.upward_weight, Range::non_negative());
-  j.height_weight = env.get("height_weight", j.height_weight, Range::non_negative());
-  j.end_x = env.get("end_x", j.end_x, Range::any());
-  j.curb_height = env.get("curb_height", j.curb_height, Range::positive());
-  j.curb_height_min = env.get("curb_height_min", j.curb_height, Range::positive());
-  if (j.curb_height_min > j.curb_height) throw env.error("curb_height_min", "must be at most curb_height");
-  j.curbs = env.get("curbs", j.curbs, Range::at_least(1));
-  j.curb_spacing = env.get("curb_spacing", j.curb_spacing, Range::positive());
-  j.clearance_weight = env.get("clearance_weight", j.clearance_weight, Range::non_negative());
-  j.clearance_before = env.get("clearance_before", j.clearance_before, Range::non_negative());
-  j.peak_weight = env.get("peak_weight", j.peak_weight, Range::non_negative());
-  j.contact_ends = env.get("contact_ends", j.contact_ends);
-  j.mark_upward_weight = env.get("mark_upward_weight", j.mark_upward_weight, Range::non_negative());
-  j.ghost_curbs = env.get("ghost_curbs", j.ghost_curbs);
-  j.ghost_depth_cost = env.get("ghost_depth_cost", j.ghost_depth_cost, Range::non_negative());
-  j.takeoff_bonus = env.get("takeoff_bonus", j.takeoff_bonus, Range::non_negative());
-  j.close_stance_cost = env.get("close_stance_cost", j.close_stance_cost, Range::non_negative());
-  j.stance_height = env.get("stance_height", j.stance_height, Range::non_negative());
-  j.placement_bonus = env.get("placement_bonus", j.placement_bonus, Range::non_negative());
-  j.placement_target = env.get("placement_target", j.placement_target, Range::any());
-  j.placement_width = env.get("placement_width", j.placement_width, Range::positive());
-  j.approach_speed = env.get("approach_speed", j.approach_speed, Range::non_negative());
-  j.approach_from = env.get("approach_from", j.approach_from, Range::positive());
-  j.approach_to = env.get("approach_to", j.approach_to, Range::non_negative());
-  if (!(j.approach_to < j.approach_from)) throw env.error("approach_to", "must be below approach_from");
-  if (env.has("takeoff_zone")) {
-    const auto zone = env.get("takeoff_zone", std::vector<double>(), Range::at_most(0));
-    if (zone.size() != 2 || !(zone[0] < zone[1]))
-      throw env.error("takeoff_zone", "must be [low, high] with low < high <= 0 (metres before the curb)");
-    j.takeoff_zone = {zone[0], zone[1]};
-  }
-  if (j.curbs > 1 && j.curb_spacing <= 2 * j.curb_noise + o.curb_width)
-    throw env.error("curb_spacing", "must exceed 2 curb_noise + curb_width so curbs do not overlap");
+  const WalkerConfig w = WalkerConfig::read(env);
+  const ObstacleConfig o = ObstacleConfig::read(env);
+  const WalkerJump::Config j = WalkerJump::Config::read(env, o);
   return [=] { return std::make_unique<WalkerJump>(name, w, o, j); };
 }
 
 Factory walker_crawl(const std::string& name, const Section& env) {
   WalkerConfig defaults;
   defaults.fall_height = 0.3;  // crawling is low: only a torso below 0.3 m is a fall
-  WalkerConfig w = WalkerConfig::read(env, defaults);
-  ObstacleConfig o = ObstacleConfig::read(env);
-  WalkerCrawl::Config c;
-  c.ceiling_start = env.get("ceiling_start", c.ceiling_start, Range::any());
-  c.ceiling_end = env.get("ceiling_end", c.ceiling_end, Range::any());
-  c.crouch_weight = env.get("crouch_weight", c.crouch_weight, Range::non_negative());
-  c.crouch_height = env.get("crouch_height", c.crouch_height, Range::positive());
-  if (!(c.ceiling_start < c.ceiling_end)) throw env.error("ceiling_end", "must be beyond ceiling_start");
+  const WalkerConfig w = WalkerConfig::read(env, defaults);
+  const ObstacleConfig o = ObstacleConfig::read(env);
+  const WalkerCrawl::Config c = WalkerCrawl::Config::read(env);
   return [=] { return std::make_unique<WalkerCrawl>(name, w, o, c); };
 }
 
@@ -100,27 +59,11 @@ WalkerConfig composite_defaults(int max_steps) {
 }
 
 // Hurdle and Obstacle course differ only in their layout defaults.
-Builder walker_course(WalkerCourse::Config defaults, int max_steps) {
-  return [defaults, max_steps](const std::string& name, const Section& env) -> Factory {
-    const WalkerConfig wd = composite_defaults(max_steps);
-    WalkerConfig w = WalkerConfig::read(env, wd);
-    ObstacleConfig o = ObstacleConfig::read(env);
-    WalkerCourse::Config c = defaults;
-    c.positions = env.get("positions", c.positions, Range::any());
-    c.position_noise = env.get("position_noise", c.position_noise, Range::non_negative());
-    c.kinds = env.get("kinds", c.kinds);
-    c.shuffle = env.get("shuffle", c.shuffle);
-    c.pass_bonus = env.get("pass_bonus", c.pass_bonus, Range::non_negative());
-    c.speed_weight = env.get("speed_weight", c.speed_weight, Range::non_negative());
-    c.height_weight = env.get("height_weight", c.height_weight, Range::non_negative());
-    c.cross_bonus = env.get("cross_bonus", c.cross_bonus, Range::non_negative());
-    c.mark_upward_weight = env.get("mark_upward_weight", c.mark_upward_weight, Range::non_negative());
-    c.ceiling_zone = env.get("ceiling_zone", c.ceiling_zone, Range::non_negative());
-    c.ceiling_fall_height = env.get("ceiling_fall_height", c.ceiling_fall_height, Range::non_negative());
-    if (c.kinds.size() != c.positions.size())
-      throw env.error("kinds", "needs one entry per position (" + std::to_string(c.positions.size()) + ")");
-    for (const auto& k : c.kinds)
-      if (k != "curb" && k != "ceiling") throw env.error("kinds", "entries are 'curb' or 'ceiling', got '" + k + "'");
+Builder walker_course(WalkerCourse::Config layout, int max_steps) {
+  return [layout, max_steps](const std::string& name, const Section& env) -> Factory {
+    const WalkerConfig w = WalkerConfig::read(env, composite_defaults(max_steps));
+    const ObstacleConfig o = ObstacleConfig::read(env);
+    const WalkerCourse::Config c = WalkerCourse::Config::read(env, layout);
     return [=] { return std::make_unique<WalkerCourse>(name, w, o, c); };
   };
 }
@@ -141,13 +84,8 @@ WalkerCourse::Config obstacle_course_layout() {
 }
 
 Factory walker_patrol(const std::string& name, const Section& env) {
-  WalkerConfig w = WalkerConfig::read(env, composite_defaults(10000));
-  WalkerPatrol::Config c;
-  c.stone_x = env.get("stone_x", c.stone_x, Range::positive());
-  c.max_turns = env.get("max_turns", c.max_turns, Range::at_least(1));
-  c.turn_bonus = env.get("turn_bonus", c.turn_bonus, Range::non_negative());
-  c.min_pass_speed = env.get("min_pass_speed", c.min_pass_speed, Range::non_negative());
-  c.max_leg_steps = env.get("max_leg_steps", c.max_leg_steps, Range::non_negative());
+  const WalkerConfig w = WalkerConfig::read(env, composite_defaults(10000));
+  const WalkerPatrol::Config c = WalkerPatrol::Config::read(env);
   return [=] { return std::make_unique<WalkerPatrol>(name, w, c); };
 }
 
@@ -174,41 +112,22 @@ JacoConfig jaco_composite(const Section& env, int max_steps, int random_steps = 
   return JacoConfig::read(env, d);
 }
 
-int read_successes(const Section& env) {
-  return env.get("successes", 5, Range::at_least(1));
-}
-
 Factory repetitive_picking(const std::string& name, const Section& env) {
-  JacoConfig c = jaco_composite(env, 1000);
-  JacoRepetitivePick::Config k;
-  k.successes = read_successes(env);
-  k.pick_steps = env.get("pick_steps", k.pick_steps, Range::at_least(1));
-  k.unwind_arm = env.get("unwind_arm", k.unwind_arm);
-  k.pick = PickRule::Config::read(env);
+  const JacoConfig c = jaco_composite(env, 1000);
+  const JacoRepetitivePick::Config k = JacoRepetitivePick::Config::read(env);
   return [=] { return std::make_unique<JacoRepetitivePick>(name, c, k); };
 }
 
 Factory repetitive_catching(const std::string& name, const Section& env) {
   // The first box falls for 10 random steps before its throw, as in Catch (the reference: 0).
-  JacoConfig c = jaco_composite(env, 1000, 10);
-  JacoRepetitiveCatch::Config k;
-  k.successes = read_successes(env);
-  k.pin_steps = env.get("pin_steps", k.pin_steps, Range::non_negative());
-  k.fall_steps = env.get("fall_steps", k.fall_steps, Range::non_negative());
-  k.unwind_arm = env.get("unwind_arm", k.unwind_arm);
-  k.catching = CatchRule::Config::read(env, /*hold_target=*/{0.0, 0.2, 0.2});  // KeepCatch's, not Catch's
+  const JacoConfig c = jaco_composite(env, 1000, 10);
+  const JacoRepetitiveCatch::Config k = JacoRepetitiveCatch::Config::read(env);
   return [=] { return std::make_unique<JacoRepetitiveCatch>(name, c, k); };
 }
 
-// Serve's `start`, `start_noise` and `vel_noise` are the toss's (the ball starts on the ground).
 Factory serve(const std::string& name, const Section& env) {
-  JacoConfig c = jaco_composite(env, 300);
-  JacoServe::Config k;
-  k.judge_height = env.get("judge_height", k.judge_height, Range::non_negative());
-  k.toss_bonus = env.get("toss_bonus", k.toss_bonus, Range::non_negative());
-  k.toss_tolerance = env.get("toss_tolerance", k.toss_tolerance, Range::non_negative());
-  k.toss = TossRule::Config::read(env);
-  k.hit = HitRule::Config::read(env);
+  const JacoConfig c = jaco_composite(env, 300);
+  const JacoServe::Config k = JacoServe::Config::read(env);
   return [=] { return std::make_unique<JacoServe>(name, c, k); };
 }
 

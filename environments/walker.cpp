@@ -51,9 +51,8 @@ double WalkerEnv::trailing_foot_x() const {
   return std::min(data_->xpos[3 * foot_], data_->xpos[3 * foot_left_]);
 }
 
-double WalkerEnv::walk_reward(double v, const float* action, double speed_weight, double height_weight,
-                              double target_speed) const {
-  return speed_weight * speed_term(v, target_speed) - height_weight * std::abs(cfg_.height_target - delta_h()) +
+double WalkerEnv::walk_reward(double v, const float* action, double speed_weight, double height_weight) const {
+  return speed_weight * speed_term(v, cfg_.target_speed) - height_weight * std::abs(cfg_.height_target - delta_h()) +
          posture_terms(action);
 }
 

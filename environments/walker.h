@@ -63,13 +63,8 @@ class WalkerEnv : public MujocoEnv {
 
   WalkerConfig cfg_;
   // Forward-velocity, height and posture terms shared by walk-like rewards:
-  //   speed_weight v' + upright + alive - height_weight |h* - dh| - foot - ctrl,
-  // v' about target_speed (by default the config's).
-  double walk_reward(double v, const float* action, double speed_weight, double height_weight,
-                     double target_speed) const;
-  double walk_reward(double v, const float* action, double speed_weight, double height_weight) const {
-    return walk_reward(v, action, speed_weight, height_weight, cfg_.target_speed);
-  }
+  //   speed_weight v' + upright + alive - height_weight |h* - dh| - foot - ctrl.
+  double walk_reward(double v, const float* action, double speed_weight, double height_weight) const;
   // The result of a step in a "survive success_steps steps" task.
   StepResult survival_step(double reward, bool ended) const;
 

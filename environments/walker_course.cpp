@@ -2,8 +2,28 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 namespace segue {
+
+WalkerCourse::Config WalkerCourse::Config::read(const Section& env, Config c) {
+  c.positions = env.get("positions", c.positions, Range::any());
+  c.position_noise = env.get("position_noise", c.position_noise, Range::non_negative());
+  c.kinds = env.get("kinds", c.kinds);
+  c.shuffle = env.get("shuffle", c.shuffle);
+  c.pass_bonus = env.get("pass_bonus", c.pass_bonus, Range::non_negative());
+  c.speed_weight = env.get("speed_weight", c.speed_weight, Range::non_negative());
+  c.height_weight = env.get("height_weight", c.height_weight, Range::non_negative());
+  c.cross_bonus = env.get("cross_bonus", c.cross_bonus, Range::non_negative());
+  c.mark_upward_weight = env.get("mark_upward_weight", c.mark_upward_weight, Range::non_negative());
+  c.ceiling_zone = env.get("ceiling_zone", c.ceiling_zone, Range::non_negative());
+  c.ceiling_fall_height = env.get("ceiling_fall_height", c.ceiling_fall_height, Range::non_negative());
+  if (c.kinds.size() != c.positions.size())
+    throw env.error("kinds", "needs one entry per position (" + std::to_string(c.positions.size()) + ")");
+  for (const auto& k : c.kinds)
+    if (k != "curb" && k != "ceiling") throw env.error("kinds", "entries are 'curb' or 'ceiling', got '" + k + "'");
+  return c;
+}
 
 WalkerCourse::WalkerCourse(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o,
                            const Config& c)

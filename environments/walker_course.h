@@ -28,6 +28,8 @@ class WalkerCourse : public WalkerObstacleEnv {
     double cross_bonus = 0.0, mark_upward_weight = 0.0;
     double ceiling_zone = 3.0;           // within this of a ceiling, only a torso below
     double ceiling_fall_height = 0.3;    //   ceiling_fall_height is a fall (crawling is low)
+    // Reads `env`, starting from `defaults` (Hurdle's or Obstacle course's layout).
+    static Config read(const Section& env, Config defaults);
   };
   WalkerCourse(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
 

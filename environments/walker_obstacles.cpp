@@ -6,19 +6,6 @@
 
 namespace segue {
 
-double capsule_depth_in_box(const std::array<double, 2>& p0, const std::array<double, 2>& p1, double r,
-                            double x0, double x1, double height) {
-  double deepest = 0.0;
-  for (int i = 0; i <= 8; ++i) {
-    const double t = i / 8.0, x = p0[0] + t * (p1[0] - p0[0]), z = p0[1] + t * (p1[1] - p0[1]);
-    const double dx = std::max({x0 - x, x - x1, 0.0}), dz = std::max({-z, z - height, 0.0});
-    const double signed_distance = (dx > 0 || dz > 0) ? std::hypot(dx, dz)
-                                                      : -std::min({x - x0, x1 - x, z, height - z});
-    deepest = std::max(deepest, r - signed_distance);
-  }
-  return deepest;
-}
-
 ObstacleConfig ObstacleConfig::read(const Section& s, ObstacleConfig c) {
   c.detect_distance = s.get("detect_distance", c.detect_distance, Range::positive());
   c.curb_far_start = s.get("curb_far_start", c.curb_far_start, Range::non_negative());
@@ -87,10 +74,6 @@ void WalkerObstacleEnv::set_curb_height(size_t index, double height) {
   model_->geom_pos[3 * g + 2] = 0.5 * height;
   const double* s = &model_->geom_size[3 * g];
   model_->geom_rbound[g] = std::sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
-}
-
-void WalkerObstacleEnv::make_curbs_ghosts() {
-  for (int g : curb_geoms_) model_->geom_contype[g] = model_->geom_conaffinity[g] = 0;
 }
 
 int WalkerObstacleEnv::next_obstacle() const {
@@ -181,27 +164,30 @@ void WalkerObstacleEnv::restore_task_state(const double* in, size_t n) {
 
 // ---- jump ------------------------------------------------------------------------------
 
+WalkerJump::Config WalkerJump::Config::read(const Section& env, const ObstacleConfig& obstacles) {
+  Config c;
+  c.curb_x = env.get("curb_x", c.curb_x, Range::any());
+  c.curb_noise = env.get("curb_noise", c.curb_noise, Range::non_negative());
+  c.cross_bonus = env.get("cross_bonus", c.cross_bonus, Range::non_negative());
+  c.upward_weight = env.get("upward_weight", c.upward_weight, Range::non_negative());
+  c.height_weight = env.get("height_weight", c.height_weight, Range::non_negative());
+  c.end_x = env.get("end_x", c.end_x, Range::any());
+  c.curb_height = env.get("curb_height", c.curb_height, Range::positive());
+  c.curb_height_min = env.get("curb_height_min", c.curb_height, Range::positive());
+  if (c.curb_height_min > c.curb_height) throw env.error("curb_height_min", "must be at most curb_height");
+  c.curbs = env.get("curbs", c.curbs, Range::at_least(1));
+  c.curb_spacing = env.get("curb_spacing", c.curb_spacing, Range::positive());
+  c.contact_ends = env.get("contact_ends", c.contact_ends);
+  c.mark_upward_weight = env.get("mark_upward_weight", c.mark_upward_weight, Range::non_negative());
+  if (c.curbs > 1 && c.curb_spacing <= 2 * c.curb_noise + obstacles.curb_width)
+    throw env.error("curb_spacing", "must exceed 2 curb_noise + curb_width so curbs do not overlap");
+  return c;
+}
+
 WalkerJump::WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c)
     : WalkerObstacleEnv(name, w, o, true), jcfg_(c) {
   spec_.feature_names = {"curb_ahead", "curb_behind"};
   require_obstacles(size_t(jcfg_.curbs), 0, "curbs");
-  if (jcfg_.ghost_curbs) make_curbs_ghosts();
-  for (int g = 0; g < model_->ngeom; ++g)
-    if (model_->geom_bodyid[g] != 0 && model_->geom_type[g] == mjGEOM_CAPSULE) walker_capsules_.push_back(g);
-}
-
-double WalkerJump::depth_in_curb(size_t k) const {
-  const Obstacle& c = obstacles_.at(k);
-  const double height = heights_.at(k);
-  double depth = 0.0;
-  for (int g : walker_capsules_) {
-    const double* p = &data_->geom_xpos[3 * g];
-    const double* m = &data_->geom_xmat[9 * g];
-    const double half = model_->geom_size[3 * g + 1];  // the axis is the geom's local z
-    depth += capsule_depth_in_box({p[0] - half * m[2], p[2] - half * m[8]}, {p[0] + half * m[2], p[2] + half * m[8]},
-                                  model_->geom_size[3 * g], c.start, c.end, height);
-  }
-  return depth;
 }
 
 void WalkerJump::features(double* out) const {
@@ -221,43 +207,19 @@ void WalkerJump::reset_task() {
   }
   set_obstacles(layout);
   for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
-  crossed_ = 0, touched_ = 0, took_off_ = 0, placed_ = 0;
-  footfall_curb_ = -1, footfall_ = 0.0;
-  peak_curb_ = -1, peak_ = 0.0;
+  crossed_ = 0, touched_ = 0;
   WalkerEnv::reset_task();
-}
-
-double WalkerJump::clearance(int foot, double height) const {
-  return std::clamp((data_->xpos[3 * foot + 2] - kFootRadius) / height, 0.0, 1.0);
-}
-
-double WalkerJump::placement_reward(int k) {
-  if (k < 0 || k >= 32 || (placed_ >> k & 1u)) return 0.0;
-  placed_ |= 1u << k;
-  if (footfall_curb_ != k) return 0.0;
-  const double z = (footfall_ - jcfg_.placement_target) / jcfg_.placement_width;
-  return jcfg_.placement_bonus * std::exp(-0.5 * z * z);
-}
-
-double WalkerJump::speed_target(int next) const {
-  if (jcfg_.approach_speed <= 0 || next < 0) return cfg_.target_speed;
-  const double d = obstacles_[next].start - min_x();
-  if (d >= jcfg_.approach_from) return cfg_.target_speed;
-  const double w = std::clamp((jcfg_.approach_from - d) / (jcfg_.approach_from - jcfg_.approach_to), 0.0, 1.0);
-  return cfg_.target_speed + w * (jcfg_.approach_speed - cfg_.target_speed);
 }
 
 StepResult WalkerJump::evaluate(const float* action) {
   StepResult r;
   double v = x_velocity();
-  const int next = next_obstacle();
-  r.reward = walk_reward(v, action, 2.0, jcfg_.height_weight, speed_target(next));
+  r.reward = walk_reward(v, action, 2.0, jcfg_.height_weight);
   // Bonuses for the trailing foot crossing each curb's start, centre and end.
   const int marks = 3 * int(obstacles_.size());
   while (crossed_ < marks) {
     if (trailing_foot_x() <= curb_marks(obstacles_[crossed_ / 3])[crossed_ % 3]) break;
     if (!(touched_ >> (crossed_ / 3) & 1u)) r.reward += jcfg_.cross_bonus;
-    if (crossed_ % 3 == 0) r.reward += placement_reward(crossed_ / 3);
     ++crossed_;
   }
   if (jcfg_.mark_upward_weight != 0.0)
@@ -266,42 +228,15 @@ StepResult WalkerJump::evaluate(const float* action) {
         if (x_before_ <= at && at < torso_x())
           r.reward += jcfg_.mark_upward_weight * std::clamp(z_velocity(), -2.0, 2.0);
   double x = min_x();
+  const int next = next_obstacle();
   if (next >= 0) {
     const Obstacle& curb = obstacles_[next];
     if (x > curb.start - 1.0 && x < curb.end) r.reward += jcfg_.upward_weight * std::max(z_velocity(), 0.0);
-    if (x > curb.start - jcfg_.clearance_before && x < curb.end) {
-      const double lower = std::min(clearance(foot_, heights_[next]), clearance(foot_left_, heights_[next]));
-      r.reward += jcfg_.clearance_weight * lower;
-      if (peak_curb_ != next) peak_curb_ = next, peak_ = 0.0;
-      const double rise = lower * heights_[next] - peak_;
-      if (rise > 0) r.reward += jcfg_.peak_weight * rise, peak_ += rise;
-    }
-    // Each foot in stance, at its ankle's x relative to the curb's start.
-    const double a1 = data_->xpos[3 * foot_] - curb.start, a2 = data_->xpos[3 * foot_left_] - curb.start;
-    const bool both_before = std::max(a1, a2) < 0.0;
-    for (auto [f, at] : {std::pair{foot_, a1}, std::pair{foot_left_, a2}}) {
-      if (data_->xpos[3 * f + 2] > jcfg_.stance_height) continue;
-      if (at >= jcfg_.takeoff_zone[0] && at <= jcfg_.takeoff_zone[1] && !(took_off_ >> next & 1u))
-        r.reward += jcfg_.takeoff_bonus, took_off_ |= 1u << next;
-      else if (at > jcfg_.takeoff_zone[1] && at < 0.0)
-        r.reward -= jcfg_.close_stance_cost;
-      if (both_before && (footfall_curb_ != next || at > footfall_)) footfall_curb_ = next, footfall_ = at;
-    }
   }
-  bool contact = false;
-  if (jcfg_.ghost_curbs) {
-    for (size_t k = 0; k < obstacles_.size(); ++k) {
-      if (std::abs(obstacles_[k].start - torso_x()) > 2.0) continue;  // out of the walker's reach
-      const double depth = depth_in_curb(k);
-      if (depth <= 0) continue;
-      contact = true, touched_ |= 1u << k;
-      r.reward -= jcfg_.ghost_depth_cost * depth;
-    }
-    if (contact) r.reward -= ocfg_.contact_penalty;
-  } else if ((contact = touching())) {
+  const bool contact = touching();
+  if (contact) {
     r.reward -= ocfg_.contact_penalty;
     if (next >= 0 && next < 32) touched_ |= 1u << next;
-    r.reward += placement_reward(next);
   }
   update_passed();
   r.info.success = passed_ == int(obstacles_.size()) && touched_ == 0;
@@ -314,31 +249,28 @@ StepResult WalkerJump::evaluate(const float* action) {
 
 void WalkerJump::save_extra(std::vector<double>& out) const {
   out.push_back(crossed_);
-  out.push_back(peak_curb_);
-  out.push_back(peak_);
   out.push_back(touched_);
-  out.push_back(took_off_);
   out.insert(out.end(), heights_.begin(), heights_.end());
-  out.push_back(placed_);
-  out.push_back(footfall_curb_);
-  out.push_back(footfall_);
 }
 void WalkerJump::restore_extra(const double* in, size_t n) {
   crossed_ = n > 0 ? int(in[0]) : 0;
-  peak_curb_ = n > 1 ? int(in[1]) : -1;
-  peak_ = n > 2 ? in[2] : 0.0;
-  touched_ = n > 3 ? uint32_t(in[3]) : 0u;
-  took_off_ = n > 4 ? uint32_t(in[4]) : 0u;
+  touched_ = n > 1 ? uint32_t(in[1]) : 0u;
   heights_.assign(obstacles_.size(), jcfg_.curb_height);
-  for (size_t k = 0; k + 5 < n && k < heights_.size(); ++k) heights_[k] = in[5 + k];
+  for (size_t k = 0; k + 2 < n && k < heights_.size(); ++k) heights_[k] = in[2 + k];
   for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
-  const size_t p = 5 + heights_.size();  // placement state follows the heights
-  placed_ = n > p ? uint32_t(in[p]) : 0u;
-  footfall_curb_ = n > p + 1 ? int(in[p + 1]) : -1;
-  footfall_ = n > p + 2 ? in[p + 2] : 0.0;
 }
 
 // ---- crawl -----------------------------------------------------------------------------
+
+WalkerCrawl::Config WalkerCrawl::Config::read(const Section& env) {
+  Config c;
+  c.ceiling_start = env.get("ceiling_start", c.ceiling_start, Range::any());
+  c.ceiling_end = env.get("ceiling_end", c.ceiling_end, Range::any());
+  c.crouch_weight = env.get("crouch_weight", c.crouch_weight, Range::non_negative());
+  c.crouch_height = env.get("crouch_height", c.crouch_height, Range::positive());
+  if (!(c.ceiling_start < c.ceiling_end)) throw env.error("ceiling_end", "must be beyond ceiling_start");
+  return c;
+}
 
 WalkerCrawl::WalkerCrawl(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c)
     : WalkerObstacleEnv(name, w, o, false), ccfg_(c) {}

@@ -14,13 +14,6 @@ namespace segue {
 
 enum class ObstacleKind { Curb = 1, Ceiling = 2 };
 
-// How deep a capsule (axis p0-p1, radius r, points as (x, z)) reaches into the box
-// [x0, x1] x [0, height] standing on the floor, in the walker's x-z plane: the largest
-// r - signed distance to the box over nine points along the axis (a close approximation
-// that is exact when the deepest point is one of them), 0 when it stays clear.
-double capsule_depth_in_box(const std::array<double, 2>& p0, const std::array<double, 2>& p1, double r,
-                            double x0, double x1, double height);
-
 struct Obstacle {
   ObstacleKind kind;
   double start, end;  // x extent
@@ -69,8 +62,6 @@ class WalkerObstacleEnv : public WalkerEnv {
   void require_obstacles(size_t curbs, size_t ceilings, const std::string& key) const;
   // Resizes the index-th curb of the layout to this height (it stands on the floor).
   void set_curb_height(size_t index, double height);
-  // Curbs stop colliding: the walker passes through them (a training curriculum).
-  void make_curbs_ghosts();
   // Counts obstacles newly passed this step (in course order); returns how many.
   int update_passed();
   void observe(float* obs) const override;
@@ -111,16 +102,6 @@ class WalkerJump : public WalkerObstacleEnv {
     double curb_height = 0.4, curb_height_min = 0.4;
     int curbs = 1;               // the task has one; more give more attempts per episode
     double curb_spacing = 8.0;   // nominal distance between successive curbs' starts
-    // + clearance_weight min over both feet of min(1, foot clearance / curb height) while
-    // the walker is over or up to clearance_before before the next curb: both feet off the
-    // ground together is a jump, which the crossing bonuses pay only once it succeeds.
-    double clearance_weight = 0.0, clearance_before = 0.3;
-    // + peak_weight times each rise of the lower foot's bottom to a new height for this
-    // curb (up to the curb's height), in the same window: in all, peak_weight times the
-    // highest both feet were off the ground together. Unlike upward_weight, which pays
-    // every upward movement and so pays many small hops as well as one high one, this pays
-    // only the height of the highest.
-    double peak_weight = 0.0;
     // + mark_upward_weight clip(vz, -2, 2) once as the torso passes each curb's start,
     // centre and end (vz the torso's vertical speed): the reference's jump term, which
     // pays rising, and charges falling, at the moments that decide a clearance.
@@ -130,47 +111,14 @@ class WalkerJump : public WalkerObstacleEnv {
     // still shows what follows a crossing, and a clean crossing is worth the bonuses more
     // than a touched one; the reference task ends on the first touch.
     bool contact_ends = true;
-    // true (training only): curbs do not collide. A walker geom reaching into a curb's
-    // box counts as touching it (contact_penalty, the curb's bonuses forfeit, the episode
-    // ends if contact_ends) and costs ghost_depth_cost per metre of depth (summed over the
-    // walker's geoms) each step. A foot that is too low then costs in proportion to how
-    // much too low it is, instead of tripping the walker.
-    bool ghost_curbs = false;
-    double ghost_depth_cost = 0.0;
-    // Take-off shaping (training only). A foot is in stance when its ankle is within
-    // stance_height of the floor; x is its ankle relative to the next curb's start.
-    // + takeoff_bonus once per curb for a stance with x in takeoff_zone, the stretch a
-    // clearing jump starts from; - close_stance_cost each step a foot stands between the
-    // zone and the curb, too close to clear it. Stage 3's hop clears the curb exactly
-    // when its last stance is in [-1.23, -0.59] and touches it from every other (the
-    // jump's curriculum in docs/history.md): it does not place its take-off.
-    double takeoff_bonus = 0.0, close_stance_cost = 0.0;
-    std::array<double, 2> takeoff_zone = {-1.2, -0.6};
-    double stance_height = 0.08;
-    // Graded take-off shaping (training only): once per curb, when its outcome is decided
-    // (the trailing foot passes its start, or the walker first touches it), + placement_bonus
-    // exp(-((x - placement_target) / placement_width)^2 / 2), x the frontmost footfall before
-    // the curb (while both feet were before it; in a forward run, the take-off). Success is a window of
-    // take-off points (stage 3: [-1.23, -0.59] m) and is flat outside it, so a take-off
-    // 0.5 m off gains nothing from a slightly longer or shorter step; the takeoff_zone bonus
-    // is flat in the same way. This term rewards every step of the way towards the window.
-    double placement_bonus = 0.0, placement_target = -0.8, placement_width = 0.3;
-    // Slow approach (training only; 0 = off): the speed term's target falls linearly from
-    // the walker's target_speed at approach_from metres before the next curb to
-    // approach_speed at approach_to, and stays there until the curb's end. A gait whose
-    // steps are shorter than the clearing window (~0.6 m) always has a footfall inside it,
-    // so when to take off becomes a choice at one footfall, not a lengthening or shortening
-    // of the hops before it (which no stage learnt).
-    double approach_speed = 0.0, approach_from = 3.0, approach_to = 1.5;
+    // Reads `env`, refusing curbs laid out so close that they overlap.
+    static Config read(const Section& env, const ObstacleConfig& obstacles);
   };
   WalkerJump(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
   // Features, as Hurdle's: curb_ahead (metres from x to the next curb's start, far when
   // none) and curb_behind (metres past the last curb's end). A skill recipe's lead_in
   // reads them (hrl/lead_in.h).
   void features(double* out) const override;
-  // Summed depth of the walker's capsules in curb k's box (capsule_depth_in_box): what
-  // ghost curbs charge; with solid curbs MuJoCo keeps it near 0.
-  double depth_in_curb(size_t k) const;
 
  protected:
   void reset_task() override;
@@ -179,25 +127,9 @@ class WalkerJump : public WalkerObstacleEnv {
   void restore_extra(const double* in, size_t n) override;
 
  private:
-  static constexpr double kFootRadius = 0.06;  // walker_base.xml's foot capsules
-  // How far the bottom of `foot` (a body id) is above the ground, as a fraction of the
-  // curb's height, in [0, 1].
-  double clearance(int foot, double height) const;
-  // placement_bonus for curb k's frontmost footfall (0 without one), paid once.
-  double placement_reward(int k);
-  // The speed term's target at this step (approach_speed's ramp near a curb).
-  double speed_target(int next) const;
-  std::vector<int> walker_capsules_;  // the walker's geoms (all capsules), for depth_in_curb
-
   Config jcfg_;
   int crossed_ = 0;              // marks (start, centre, end of each curb) the trailing foot has crossed
   uint32_t touched_ = 0;         // bit k: curb k was touched (only with contact_ends false)
-  uint32_t took_off_ = 0;        // bit k: curb k's takeoff_bonus was paid
-  uint32_t placed_ = 0;          // bit k: curb k's placement_bonus was paid
-  int footfall_curb_ = -1;       // the curb footfall_ belongs to
-  double footfall_ = 0.0;        // frontmost footfall before that curb, relative to its start
-  int peak_curb_ = -1;           // the curb peak_ belongs to
-  double peak_ = 0.0;            // highest lower-foot clearance (m) in that curb's window so far
   std::vector<double> heights_;  // per curb
 };
 
@@ -210,6 +142,7 @@ class WalkerCrawl : public WalkerObstacleEnv {
     // without one PPO finds diving flat and dragging itself along (the torso then sits at
     // the 0.3 m fall line: 25-35% success from 5M to 11M steps). 0 = the reference reward.
     double crouch_weight = 0.0, crouch_height = 0.6;
+    static Config read(const Section& env);
   };
   WalkerCrawl(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
 

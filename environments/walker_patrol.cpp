@@ -4,6 +4,16 @@
 
 namespace segue {
 
+WalkerPatrol::Config WalkerPatrol::Config::read(const Section& env) {
+  Config c;
+  c.stone_x = env.get("stone_x", c.stone_x, Range::positive());
+  c.max_turns = env.get("max_turns", c.max_turns, Range::at_least(1));
+  c.turn_bonus = env.get("turn_bonus", c.turn_bonus, Range::non_negative());
+  c.min_pass_speed = env.get("min_pass_speed", c.min_pass_speed, Range::non_negative());
+  c.max_leg_steps = env.get("max_leg_steps", c.max_leg_steps, Range::non_negative());
+  return c;
+}
+
 WalkerPatrol::WalkerPatrol(const std::string& name, const WalkerConfig& w, const Config& c)
     : WalkerEnv(name, w, "walker/walker_patrol.xml"), pcfg_(c) {
   spec_.obs_dim = kBaseObsDim + 1;

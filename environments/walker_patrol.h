@@ -24,6 +24,7 @@ class WalkerPatrol : public WalkerEnv {
     // m/s); a leg (from the start or a turn to the next turn) of more control steps ends it (800).
     double min_pass_speed = 0.0;
     int max_leg_steps = 0;  // 0: no limit
+    static Config read(const Section& env);
   };
   WalkerPatrol(const std::string& name, const WalkerConfig& w, const Config& c);
 

@@ -212,41 +212,6 @@ TEST(Jaco, PickRewardsAndSuccessByHand) {
   EXPECT_TRUE(r.terminated);
   EXPECT_TRUE(r.info.success);
   EXPECT_NEAR(got, expected, 1e-3);
-
-  // With center_weight, each held step also costs center_weight |hand - box|.
-  auto centred = make_arm<JacoPick>("jaco_pick", "{init_random_steps: 0, center_weight: 10}");
-  object_contacts_off(*centred);
-  centred->reset(4, obs.data());
-  hold_arm(*centred, q);
-  centred->forward(obs.data());
-  pin(*centred, centred->hand_pos(), obs);
-  const double first = centred->step(zero.data(), obs.data()).reward;
-  env->reset(4, obs.data());
-  hold_arm(*env, q);
-  env->forward(obs.data());
-  pin(*env, env->hand_pos(), obs);
-  const double plain = env->step(zero.data(), obs.data()).reward;
-  EXPECT_NEAR(first, plain - 10 * centred->hand_object_distance(), 1e-9);
-}
-
-TEST(Jaco, PickPushWeightCostsTheBoxsHorizontalMoveBeforeThePick) {
-  // The box, still on the ground and far from the hand, is slid 5 cm along x and 3 cm along
-  // y: with push_weight 10 the step costs 10 |its horizontal move| more than without.
-  std::vector<float> obs(49), zero(9, 0.0f);
-  double reward[2], moved = 0;
-  for (int k = 0; k < 2; ++k) {
-    auto env = make_arm<JacoPick>("jaco_pick", k ? "{init_random_steps: 0, push_weight: 10}"
-                                                 : "{init_random_steps: 0}");
-    env->reset(6, obs.data());
-    const Vec3 start = env->object_pos();
-    pin(*env, {start[0] + 0.05, start[1] + 0.03, start[2]}, obs);
-    reward[k] = env->step(zero.data(), obs.data()).reward;
-    const Vec3 p = env->object_pos();
-    moved = std::hypot(p[0] - start[0], p[1] - start[1]);
-    ASSERT_GT(env->hand_object_distance(), 0.06);  // not picked
-  }
-  EXPECT_NEAR(moved, std::hypot(0.05, 0.03), 2e-3);
-  EXPECT_NEAR(reward[1], reward[0] - 10 * moved, 1e-9);
 }
 
 TEST(Jaco, PickFailsWhenTheBoxLeavesTheHandAfterThePick) {

@@ -200,8 +200,11 @@ TEST_F(CliErrors, BadRecipes) {
   expect_one_line_error(run("train " + (dir_ / "missing.yaml").string()), "missing.yaml: cannot read recipe");
   auto ok = write("ok.yaml", "task: walker_forward\n");
   expect_one_line_error(run("train " + ok + " --set ppo.lrr=1"), "unknown key 'ppo.lrr' (from --set)");
-  auto zone = write("zone.yaml", "task: walker_jump\nenv: {takeoff_zone: [-0.6, -1.2]}\n");
-  expect_one_line_error(run("train " + zone), "zone.yaml: key 'env.takeoff_zone': must be [low, high] with low < high <= 0");
+  auto close = write("close.yaml", "task: walker_jump\nenv: {curbs: 2, curb_spacing: 3}\n");
+  expect_one_line_error(run("train " + close),
+                        "close.yaml: key 'env.curb_spacing': must exceed 2 curb_noise + curb_width so curbs do not overlap");
+  auto kinds = write("kinds.yaml", "task: hurdle\nenv: {kinds: [curb]}\n");
+  expect_one_line_error(run("train " + kinds), "kinds.yaml: key 'env.kinds': needs one entry per position (5)");
   auto std_alone = write("std.yaml", "task: walker_forward\ninit_log_std: -1\n");
   expect_one_line_error(run("train " + std_alone), "key 'init_log_std': applies to a run that starts from init_from");
   auto restart = write("restart.yaml", "task: walker_forward\nrestart_lr_schedule: true\n");
