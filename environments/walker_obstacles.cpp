@@ -253,10 +253,13 @@ void WalkerJump::save_extra(std::vector<double>& out) const {
   out.insert(out.end(), heights_.begin(), heights_.end());
 }
 void WalkerJump::restore_extra(const double* in, size_t n) {
-  crossed_ = n > 0 ? int(in[0]) : 0;
-  touched_ = n > 1 ? uint32_t(in[1]) : 0u;
-  heights_.assign(obstacles_.size(), jcfg_.curb_height);
-  for (size_t k = 0; k + 2 < n && k < heights_.size(); ++k) heights_[k] = in[2 + k];
+  // A state saved by another layout (or by a Segue whose jump kept more) is refused, not misread.
+  if (n != 2 + obstacles_.size())
+    throw Error(spec_.name + ": a saved state with " + std::to_string(n) + " numbers of the jump's own, not " +
+                std::to_string(2 + obstacles_.size()) + " (saved for another layout, or by another version of Segue)");
+  crossed_ = int(in[0]);
+  touched_ = uint32_t(in[1]);
+  heights_.assign(in + 2, in + n);
   for (size_t k = 0; k < heights_.size(); ++k) set_curb_height(k, heights_[k]);
 }
 

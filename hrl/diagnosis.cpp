@@ -92,13 +92,15 @@ Diagnosis diagnose(const CompositeRecipe& r, const std::string& method, int star
   d.task = r.task, d.method = method;
   const std::vector<TransitionArtefacts> trained =
       load_transition_artefacts(r, repo_path(r.transitions_dir), "policy.pt", /*with_q=*/true);
-  std::vector<TransitionArtefacts> policies = trained;  // carry episodes on With TP (switch.lookahead > 1)
+  // With TP's: S_a collected as the pipeline collects it, episodes carried on after pi_b as
+  // switch training carries them (switch.lookahead > 1).
+  std::vector<TransitionArtefacts> policies = trained;
   for (auto& a : policies) a.q.reset();
   const SwitchConfig& sw = r.pipeline.switching;
   for (int t = 0; t < int(trained.size()); ++t) {
     if (!trained[t].policy)
       throw Error(r.transitions_dir + "/" + r.transition_name(t) + ": no policy.pt (pi_ab) to diagnose");
-    StartStates s = collect_start_states(r, t, starts, mix_seed(seed, t), trained, kStartStateEpisodes, nullptr, threads);
+    StartStates s = collect_start_states(r, t, starts, mix_seed(seed, t), policies, kStartStateEpisodes, nullptr, threads);
     SwitchInterval interval(r.make_env, r.skills, r.meta, t, std::move(s), *trained[t].policy, policies, sw.lookahead,
                             sw.max_subtask_steps);
     HandOverRates h = handover_rates(interval, trained[t].q ? &*trained[t].q : nullptr, points);

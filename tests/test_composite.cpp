@@ -16,6 +16,13 @@
 namespace segue {
 namespace {
 
+// Skills with names only, for the meta-controller's rules.
+std::vector<Skill> named_skills(const std::vector<std::string>& names) {
+  std::vector<Skill> skills(names.size());
+  for (size_t i = 0; i < names.size(); ++i) skills[i].name = names[i];
+  return skills;
+}
+
 const float kZero[6] = {0, 0, 0, 0, 0, 0};
 
 // Teleports the walker to torso x (moving at vx) and takes one step with zero action, upright.
@@ -281,9 +288,7 @@ transitions:
   - {from: walk, to: jump, when: {curb_ahead: [3, 4]}}
   - {from: jump, to: walk, when: {curb_behind: [2.5, 3.5]}})",
                                 "hurdle-rules");
-  std::vector<Skill> skills(2);
-  skills[0].name = "walk";
-  skills[1].name = "jump";
+  const std::vector<Skill> skills = named_skills({"walk", "jump"});
   auto env = make_task("hurdle", "{position_noise: 0, push_prob: 0}");
   MetaController meta(recipe.root(), skills, env->spec().feature_names);
   std::vector<float> obs(28);
@@ -324,10 +329,7 @@ transitions:
   - {from: balance, to: forward, when: {direction: 1, since_turn: [100, 1.0e+6], progress: [-1.0e+6, 4]}}
   - {from: balance, to: backward, when: {direction: -1, since_turn: [100, 1.0e+6], progress: [-1.0e+6, 4]}})",
                                 "patrol-rules");
-  std::vector<Skill> skills(3);
-  skills[0].name = "forward";
-  skills[1].name = "backward";
-  skills[2].name = "balance";
+  const std::vector<Skill> skills = named_skills({"forward", "backward", "balance"});
   MetaController meta(recipe.root(), skills, {"direction", "since_turn", "progress"});
   double f[3] = {-1, 1e6, 0};
   EXPECT_EQ(meta.start_skill(f), 1);
@@ -350,8 +352,7 @@ transitions:
 }
 
 TEST(MetaController, RefusesUnknownSkillsAndFeatures) {
-  std::vector<Skill> skills(1);
-  skills[0].name = "walk";
+  const std::vector<Skill> skills = named_skills({"walk"});
   Recipe bad_skill = Recipe::parse("start: [{skill: run}]", "r.yaml");
   try {
     MetaController(bad_skill.root(), skills, {"curb_ahead"});
@@ -372,9 +373,7 @@ static TransitionTrainingSpec spec_of(const Recipe& r, const std::vector<Skill>&
 }
 
 TEST(TransitionTrainingSpec, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
-  std::vector<Skill> skills(2);
-  skills[0].name = "walk";
-  skills[1].name = "crawl";
+  const std::vector<Skill> skills = named_skills({"walk", "crawl"});
   const std::string head = "start: [{skill: walk}]\ntransitions:\n  - {from: walk, to: crawl, when: {ceiling_ahead: [2, 3]}, ";
   Recipe ok = Recipe::parse(head + "expert: {task: walker_crawl, steps: 150}}", "r.yaml");
   // The sub-task's own features, for an expert window written in them.
@@ -419,9 +418,7 @@ TEST(TransitionTrainingSpec, ReadsAndChecksAnExpertWindowOnTheSkillsOwnTask) {
 }
 
 TEST(MetaController, ATransitionsMaxStepsCapsItsInterval) {
-  std::vector<Skill> skills(2);
-  skills[0].name = "walk";
-  skills[1].name = "crawl";
+  const std::vector<Skill> skills = named_skills({"walk", "crawl"});
   const std::string head = "start: [{skill: walk}]\ntransitions:\n  - {from: walk, to: crawl, when: {ceiling_ahead: [2, 3]}";
   Recipe plain = Recipe::parse(head + "}", "r.yaml");
   EXPECT_EQ(MetaController(plain.root(), skills, {"ceiling_ahead"}).transitions()[0].max_steps, 0);  // no cap unless asked
@@ -441,9 +438,7 @@ TEST(MetaController, ATransitionsMaxStepsCapsItsInterval) {
 }
 
 TEST(TransitionTrainingSpec, ATrainingWindowApartFromTheInterval) {
-  std::vector<Skill> skills(2);
-  skills[0].name = "walk";
-  skills[1].name = "jump";
+  const std::vector<Skill> skills = named_skills({"walk", "jump"});
   const std::string head = "start: [{skill: walk}]\ntransitions:\n  - {from: walk, to: jump, when: {curb_ahead: [3, 4]}";
   // By default pi_ab trains in the interval itself, with its cap.
   Recipe plain = Recipe::parse(head + ", max_steps: 50}", "r.yaml");

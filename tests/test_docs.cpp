@@ -1,12 +1,14 @@
 // The documentation and the shipped recipes against the code: docs/recipes.md is exactly
-// what `segue keys` prints from the loaders, and every recipe under experiments/ loads and
-// passes every check (`--check`), each stage of a curriculum included.
+// what `segue keys` prints from the loaders, docs/usage.md names every command's flags as
+// its --help does, and every recipe under experiments/ loads and passes every check
+// (`--check`), each stage of a curriculum included.
 #include <gtest/gtest.h>
 
 #include <array>
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <regex>
 #include <set>
 #include <sstream>
 #include <string>
@@ -134,6 +136,36 @@ TEST(Docs, IncludesRunOneWay) {
       }
     }
   EXPECT_GT(includes, 100);
+}
+
+// Each command's section of docs/usage.md ("### segue CMD") names exactly the flags its
+// --help lists, so neither can drift from the other.
+TEST(Docs, UsageNamesEveryCommandsFlagsAsItsHelpDoes) {
+  const std::string usage = read_file(std::string(SEGUE_SOURCE_DIR) + "/docs/usage.md");
+  const std::regex flag("--([a-z][a-z0-9-]*)");
+  auto flags_in = [&](const std::string& text) {
+    std::set<std::string> out;
+    for (std::sregex_iterator it(text.begin(), text.end(), flag), end; it != end; ++it) out.insert((*it)[1]);
+    out.erase("help");
+    return out;
+  };
+  for (const std::string cmd : {"train", "run", "eval", "report", "diagnose", "export", "render", "plot", "keys", "bench"}) {
+    SCOPED_TRACE(cmd);
+    const CliRun help = run_cli(cmd + " --help");
+    ASSERT_EQ(help.code, 0) << help.output;
+    std::set<std::string> listed;  // the "flags:" lines of --help: "  --name VALUE  text"
+    std::istringstream lines(help.output);
+    for (std::string line; std::getline(lines, line);) {
+      std::smatch m;
+      if (std::regex_search(line, m, std::regex("^  --([a-z][a-z0-9-]*)"))) listed.insert(m[1]);
+    }
+    listed.erase("help");
+    const size_t at = usage.find("### segue " + cmd + "\n");
+    ASSERT_NE(at, std::string::npos) << "docs/usage.md has no section '### segue " << cmd << "'";
+    size_t end = usage.find("\n#", at + 1);
+    const std::string section = usage.substr(at, end == std::string::npos ? std::string::npos : end - at);
+    EXPECT_EQ(flags_in(section), listed) << "docs/usage.md's '### segue " << cmd << "' against its --help";
+  }
 }
 
 }  // namespace segue

@@ -64,6 +64,31 @@ TEST_F(RunDirTest, ResumesWhenTheCodeGainedAKeyTheRecipeLeavesAtItsDefault) {
   EXPECT_EQ(refused(now, {}), "");  // the rewritten recipe holds the key now
 }
 
+TEST_F(RunDirTest, ResumesWhenTheCodeDroppedASettingTheRunLeftNeutral) {
+  // ppo.noise_repeat is no longer a setting; at 1 it changed nothing, so a run that had
+  // it at 1 resumes (its stored recipe loses the key), while one at 4 is refused by name.
+  const std::string now = "task: walker_jump\nppo:\n  lr: 0.0003\n";
+  std::filesystem::remove_all(dir_);
+  RunDir(dir_.string(), "task: walker_jump\nppo:\n  lr: 0.0003\n  noise_repeat: 1\nenv:\n  ghost_curbs: false\n");
+  EXPECT_NO_THROW(RunDir(dir_.string(), now));
+  EXPECT_EQ(read_file(path("recipe.yaml")), now);
+  std::filesystem::remove_all(dir_);
+  RunDir(dir_.string(), "task: walker_jump\nppo:\n  lr: 0.0003\n  noise_repeat: 4\n");
+  try {
+    RunDir(dir_.string(), now);
+    FAIL() << "a run with noise held for 4 steps was resumed without it";
+  } catch (const Error& e) {
+    EXPECT_EQ(std::string(e.what()), path("recipe.yaml") +
+                                         ": this run directory was started with key 'ppo.noise_repeat': 4, a setting "
+                                         "Segue no longer has (only runs at 1 resume); choose another run_dir or "
+                                         "remove the directory");
+  }
+  // A key Segue never had is a different recipe, as before.
+  std::filesystem::remove_all(dir_);
+  RunDir(dir_.string(), "task: walker_jump\nppo:\n  lr: 0.0003\n  other: 1\n");
+  EXPECT_THROW(RunDir(dir_.string(), now), Error);
+}
+
 TEST_F(RunDirTest, MetricsKeepOnlyRowsUpToTheCheckpoint) {
   std::string path = this->path("metrics.csv");
   {
