@@ -1,6 +1,8 @@
 // OnPolicyLearner's checkpoint: everything an exact resume needs (networks, optimiser,
 // normalisers, counters, the episodes in flight), one file written atomically, shared by
 // PPO and TRPO.
+#include <spdlog/spdlog.h>
+
 #include <sstream>
 
 #include "algorithms/on_policy.h"
@@ -147,7 +149,9 @@ void OnPolicyLearner::load(const std::string& path, const ArchiveReader& extra, 
       running_return_.assign(saved.running_return.begin() + first, saved.running_return.begin() + first + N);
       return;
     } catch (const Error& e) {
-      throw Error(path + ": " + e.what());
+      // Saved by a Segue whose environments kept another state: the run goes on, its
+      // episodes in flight started afresh.
+      spdlog::warn("{}: its episodes in flight cannot be put back ({}); resuming with fresh ones", path, e.what());
     }
   }
   // Episodes in flight cannot be put back (or this continues another run): start fresh

@@ -10,6 +10,11 @@ ReplayBuffer::ReplayBuffer(int64_t capacity, int obs_dim, int act_dim)
     : capacity_(capacity), obs_dim_(obs_dim), act_dim_(act_dim) {}
 
 void ReplayBuffer::resize(int64_t rows) {
+  if (obs_.capacity() < size_t(rows) * obs_dim_) {  // grow by doubling, never past the capacity
+    const size_t room = size_t(std::min(capacity_, std::max<int64_t>(2 * rows, 1024)));
+    obs_.reserve(room * obs_dim_), next_obs_.reserve(room * obs_dim_), act_.reserve(room * act_dim_);
+    reward_.reserve(room), terminal_.reserve(room);
+  }
   obs_.resize(size_t(rows) * obs_dim_);
   next_obs_.resize(size_t(rows) * obs_dim_);
   act_.resize(size_t(rows) * act_dim_);
@@ -68,11 +73,22 @@ void ReplayBuffer::load(torch::serialize::InputArchive& ar) {
   torch::Tensor c, o, n, a, r, t;
   ar.read("replay_counters", c);
   if (c[0].item<int64_t>() != capacity_ || c[3].item<int64_t>() != obs_dim_ || c[4].item<int64_t>() != act_dim_)
-    throw Error("the checkpoint's replay buffer has another capacity or row width than the recipe's");
-  size_ = c[1].item<int64_t>(), next_ = c[2].item<int64_t>();
-  resize(size_);
+    throw Error("the checkpoint's replay buffer holds " + std::to_string(c[0].item<int64_t>()) + " rows of " +
+                std::to_string(c[3].item<int64_t>()) + " + " + std::to_string(c[4].item<int64_t>()) +
+                " numbers, the recipe's " + std::to_string(capacity_) + " of " + std::to_string(obs_dim_) + " + " +
+                std::to_string(act_dim_) + ": another capacity or row width");
+  const int64_t size = c[1].item<int64_t>(), next = c[2].item<int64_t>();
   ar.read("replay_obs", o), ar.read("replay_next_obs", n), ar.read("replay_act", a);
   ar.read("replay_reward", r), ar.read("replay_terminal", t);
+  // The counters and the rows must agree: the ring's write position is past the rows until
+  // it is full.
+  if (size < 0 || size > capacity_ || next < 0 || next >= capacity_ || (size < capacity_ && next != size) ||
+      o.numel() != size * obs_dim_ || n.numel() != size * obs_dim_ || a.numel() != size * act_dim_ ||
+      r.numel() != size || t.numel() != size)
+    throw Error("the checkpoint's replay buffer is inconsistent (" + std::to_string(size) + " rows, next " +
+                std::to_string(next) + ")");
+  size_ = size, next_ = next;
+  resize(size_);
   restore(obs_, o), restore(next_obs_, n), restore(act_, a), restore(reward_, r), restore(terminal_, t);
 }
 

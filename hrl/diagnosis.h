@@ -7,8 +7,8 @@
 //   at the interval's start       Without TP at the paper's fixed point;
 //   at the interval's end         With TP: pi_ab drives the whole interval;
 //   where q_ab switches           With TP + Q;
-//   at the best of several points along pi_ab's path, in hindsight: what any switch rule
-//                                 could reach with this pi_ab (an upper bound for q_ab).
+//   at the best of several points along pi_ab's path, in hindsight (q_ab's among them):
+//                                 what a better switch could reach with this pi_ab.
 // And over the method's evaluation episodes (the recipe's seeds, as `segue report` runs
 // them): who was in control when each episode ended, at which success count, and how.
 #include <string>
@@ -25,13 +25,14 @@ struct HandOverRates {
   int starts = 0;          // S_a states tried
   double at_start = 0, at_end = 0, oracle = 0;
   double with_q = -1;        // -1: no q_ab
-  double q_progress = -1;    // mean step of q_ab's hand-over over the interval's length (0 start, 1 end)
+  double q_progress = -1;    // mean step of q_ab's hand-over over the interval's length (0 start, 1 end),
+                             // over the starts where pi_ab did not fall
   double interval_steps = 0; // mean steps pi_ab drives before the interval ends (or it falls)
   double fell = 0;           // share of starts where pi_ab fell inside the interval
 };
 
 // The rates over every state of `interval`'s S_a; `q_ab` may be null. The oracle tries
-// `points` hand-over points spread evenly along pi_ab's path (its start and end among
+// `points` >= 2 hand-over points spread evenly along pi_ab's path (its start and end among
 // them) and q_ab's, and counts a start as won when any of them succeeds.
 HandOverRates handover_rates(SwitchInterval& interval, const Policy* q_ab, int points);
 

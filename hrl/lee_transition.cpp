@@ -15,7 +15,7 @@ LeeTransitionEnv::LeeTransitionEnv(const EnvFactory& make_env, const std::vector
       max_subtask_steps_(max_subtask_steps),
       pi_b_(skills, meta, {}, SwitchRule::IntervalEnd) {
   spec_ = inner_.spec();
-  spec_.name += " (Lee et al.)";
+  spec_.name = inner_.task().spec().name + " (Lee transition)";
   spec_.act_dim += 1;  // the termination output
   spec_.act_low.push_back(-1.0f);
   spec_.act_high.push_back(1.0f);

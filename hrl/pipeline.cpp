@@ -49,6 +49,16 @@ StartStates starts_of(const CompositeRecipe& r, int t, const std::string& dir) {
   if (s.obs_dim != r.spec.obs_dim)
     throw Error(path + ": S_a of observations " + std::to_string(s.obs_dim) + " wide, but task '" + r.spec.name +
                 "' has " + std::to_string(r.spec.obs_dim));
+  if (s.size() > 0) {  // a state of another layout (an older Segue's) is refused here, naming the file
+    std::vector<double> state;
+    std::vector<float> obs(size_t(r.spec.obs_dim));
+    s.state(0, state);
+    try {
+      r.training[t].env()->restore_state(state, obs.data());
+    } catch (const Error& e) {
+      throw Error(path + ": " + e.what() + "; remove it to collect S_a again");
+    }
+  }
   return s;
 }
 

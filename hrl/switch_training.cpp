@@ -83,7 +83,7 @@ template <class T>
 void put(std::string& out, const std::vector<T>& v) {
   const int64_t n = int64_t(v.size());
   out.append(reinterpret_cast<const char*>(&n), sizeof n);
-  out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  if (n > 0) out.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
 }
 template <class T>
 std::vector<T> take(const std::string& in, size_t& at) {
@@ -91,7 +91,7 @@ std::vector<T> take(const std::string& in, size_t& at) {
   std::memcpy(&n, in.data() + at, sizeof n);
   at += sizeof n;
   std::vector<T> v(static_cast<size_t>(n));
-  std::memcpy(v.data(), in.data() + at, v.size() * sizeof(T));
+  if (n > 0) std::memcpy(v.data(), in.data() + at, v.size() * sizeof(T));
   at += v.size() * sizeof(T);
   return v;
 }
@@ -220,6 +220,10 @@ void SwitchTrainer::load(const std::string& path) {
   torch::Tensor counters, rng, torch_rng;
   try {
     ar.load_from(path);
+    torch::Tensor older;
+    if (ar.try_read("replay_action", older))
+      throw Error(path + ": a switch checkpoint written by an older Segue (its replay buffer is stored otherwise); "
+                         "remove it to train q_ab again");
     replay_.load(ar);  // first: another recipe's q_ab input is refused by name
     torch::serialize::InputArchive q, target, opt;
     ar.read("q", q);
@@ -234,7 +238,9 @@ void SwitchTrainer::load(const std::string& path) {
   } catch (const c10::Error&) {
     throw Error(path + ": not a switch-training checkpoint for this recipe's q_ab");
   } catch (const Error& e) {
-    throw Error(path + ": " + e.what() + " (switch.replay, or another task's q_ab)");
+    const std::string what = e.what();
+    if (what.rfind(path, 0) == 0) throw;
+    throw Error(path + ": " + what + " (switch.replay, or another task's q_ab)");
   }
   stored_ = counters[0].item<int64_t>();
   attempts_ = int(counters[1].item<int64_t>());

@@ -22,6 +22,7 @@ void TransitionController::resume(const Env& env, int skill) {
   skill_ = skill;
   transition_ = -1;
   entered_ = -1;
+  acted_ = -1;
   // Handed over inside an interval into `skill`: that interval counts as taken, or a skill
   // that hands over to itself would enter it again at once.
   taken_.assign(meta_.transitions().size(), 0);
@@ -70,6 +71,7 @@ void TransitionController::act(const Env& env, const float* obs, float* action) 
     }
   }
   const Skill& b = skills_[skill_];
+  acted_ = transition_;
   if (transition_ < 0) {
     b.policy.act(obs + b.obs_begin, 1, action);
     return;
@@ -91,8 +93,8 @@ void TransitionController::act(const Env& env, const float* obs, float* action) 
 }
 
 std::string TransitionController::in_control() const {
-  if (transition_ < 0) return skills_[skill_].name;
-  const Transition& tr = meta_.transitions()[transition_];
+  if (acted_ < 0) return skills_[skill_].name;
+  const Transition& tr = meta_.transitions()[acted_];
   return skills_[tr.from].name + "->" + skills_[tr.to].name;
 }
 

@@ -46,8 +46,9 @@ class TransitionController : public Controller {
   void resume(const Env& env, int skill);
   void act(const Env& env, const float* obs, float* action) override;
   int skill() const { return skill_; }
-  // The skill's name, or "a->b" while transition a->b's pi_ab (or, at a random hand-over
-  // point, Without TP's pi_a) drives.
+  // Who chose the last action: the skill's name, or "a->b" where transition a->b's pi_ab
+  // (or, at a random hand-over point, Without TP's pi_a) did, even if it ended the
+  // transition there (Lee et al.'s termination output).
   std::string in_control() const override;
   int transition() const { return transition_; }  // the transition pi_ab (or pi_a) drives, or -1
   // The transition whose interval the last act() entered (control passed to pi_ab, or
@@ -67,6 +68,7 @@ class TransitionController : public Controller {
   std::vector<float> out_;
   int skill_ = 0, transition_ = -1, steps_ = 0;  // steps_: pi_ab's in this interval
   int entered_ = -1;
+  int acted_ = -1;  // the transition whose pi_ab (or pi_a) chose the last action, or -1: pi_b (skill_)
   std::vector<char> taken_;  // per transition: entered, and its interval not left since
 };
 

@@ -33,7 +33,8 @@ TEST_F(TransitionTraining, HandOverRatesMatchAByHandReplay) {
   TransitionController after(r.skills, r.meta, {}, SwitchRule::IntervalEnd);
   std::vector<float> obs(r.spec.obs_dim), act(r.spec.act_dim), q(2);
   std::vector<double> f(r.spec.feature_names.size()), state;
-  double at_start = 0, at_end = 0, with_q = 0, oracle = 0, fell_share = 0;
+  double at_start = 0, at_end = 0, with_q = 0, oracle = 0, fell_share = 0, steps = 0, q_point = 0;
+  int q_counted = 0;
   for (int i = 0; i < starts.size(); ++i) {
     starts.state(i, state);
     // pi_ab's path through the interval: the state at each of its steps.
@@ -57,7 +58,9 @@ TEST_F(TransitionTraining, HandOverRatesMatchAByHandReplay) {
       }
     }
     const int last = int(path.size()) - 1;
+    steps += fell ? path.size() : last;  // pi_ab's steps: the forced switch's state is one past its last
     if (q_at < 0 && !fell) q_at = last;
+    if (!fell) q_point += double(q_at) / last, ++q_counted;
     auto succeeds = [&](int k) {
       env->restore_state(path[k], obs.data());
       return run_subtask(*env, after, tr.to, obs.data(), 1, max_steps);
@@ -79,9 +82,11 @@ TEST_F(TransitionTraining, HandOverRatesMatchAByHandReplay) {
   EXPECT_DOUBLE_EQ(h.with_q, with_q / 8);
   EXPECT_DOUBLE_EQ(h.oracle, oracle / 8);
   EXPECT_DOUBLE_EQ(h.fell, fell_share / 8);
+  EXPECT_DOUBLE_EQ(h.interval_steps, steps / 8);
+  ASSERT_GT(q_counted, 0);
+  EXPECT_DOUBLE_EQ(h.q_progress, q_point / q_counted);
   // pi_b (balance) falls when it takes over from the walk at once; pi_ab's hand-over helps.
   EXPECT_LT(h.at_start, h.at_end);
-  EXPECT_GE(h.oracle, std::max({h.at_start, h.at_end, h.with_q}));
   // Without q_ab there is no q_ab column.
   SwitchInterval again(r.make_env, r.skills, r.meta, 0, starts, pi_ab, {}, 1, max_steps);
   const HandOverRates plain = handover_rates(again, nullptr, points);

@@ -61,6 +61,33 @@ TEST(WalkerSubtasks, ResetIsDeterministicPerSeed) {
   }
 }
 
+// A saved state restores exactly; one with another count of the jump's own numbers (another
+// layout, or an older Segue's) is refused rather than misread.
+TEST(WalkerJump, RestoresItsOwnStateAndRefusesAnotherLayout) {
+  auto env = make_task("walker_jump", "{curbs: 3, curb_spacing: 8, curb_height_min: 0.3}");
+  std::vector<float> obs(28), again(28), act(6, 0.1f);
+  env->reset(4, obs.data());
+  for (int t = 0; t < 20; ++t) env->step(act.data(), obs.data());
+  std::vector<double> state;
+  env->save_state(state);
+  auto other = make_task("walker_jump", "{curbs: 3, curb_spacing: 8, curb_height_min: 0.3}");
+  other->reset(9, again.data());
+  other->restore_state(state, again.data());
+  EXPECT_EQ(again, obs);
+  std::vector<double> longer = state;
+  const double own = longer.back();  // the jump's own numbers: crossed, touched, one height per curb
+  EXPECT_EQ(own, 2 + 3);
+  longer.insert(longer.end() - 1, {0.0, 0.0});
+  longer.back() = own + 2;
+  try {
+    other->restore_state(longer, again.data());
+    ADD_FAILURE() << "a state of another layout was restored";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("a saved state with 7 numbers of the jump's own, not 5"), std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(WalkerJump, ObstacleObservationByHand) {
   auto env = make_task("walker_jump", "{curb_noise: 0, init_noise: 0, init_random_steps: 0, push_prob: 0}");
   auto& jump = dynamic_cast<WalkerObstacleEnv&>(*env);

@@ -14,17 +14,17 @@ const Command kDiagnose{
     "diagnose",
     "TASK [--method M] [--starts N] [--episodes N] [--json] [--plot FILE.png]",
     "Explains a composite task's results. Per transition, from N states of S_a collected\n"
-    "With TP, the share of hand-overs after which pi_b achieves its subtask: at the\n"
+    "With TP (as segue run collects them), the share of hand-overs after which pi_b achieves its subtask: at the\n"
     "interval's start (Without TP), at its end (With TP), where q_ab switches (With TP + Q)\n"
-    "and at the best of several points along pi_ab's path (a hindsight bound on any switch\n"
-    "rule). Then the method's evaluation episodes (the recipe's eval seeds, as segue report\n"
+    "and at the best of several points along pi_ab's path, in hindsight (what a better\n"
+    "switch could reach). Then the method's evaluation episodes (the recipe's eval seeds, as segue report\n"
     "runs them), grouped by who was in control when each ended, at which success count, and\n"
     "how (success, terminated, time limit). Uses the recipe's (by default the shipped) artefacts.",
     {"TASK"},
     {{"method", "M", "method whose episodes are grouped (default tp+q)"},
      {"recipe", "FILE", "composite recipe (default experiments/TASK.yaml)"},
      {"starts", "N", "S_a states per transition (default 100)"},
-     {"points", "N", "hand-over points along pi_ab's path the hindsight bound tries (default 10)"},
+     {"points", "N", "hand-over points along pi_ab's path the hindsight best tries, >= 2 (default 10)"},
      {"episodes", "N", "evaluation episodes per seed (default: the recipe's eval.episodes)"},
      {"seed", "S", "seed of S_a's collection (default 0)"},
      {"json", "", "print one JSON object instead of the tables"},
@@ -45,7 +45,7 @@ int diagnose_main(int argc, char** argv) {
   if (std::find(names.begin(), names.end(), method) == names.end())
     throw Error("segue diagnose: unknown --method '" + method + "' (methods: single, without-tp, tp, lee, tp+q)");
   const int starts = args.get_int("starts", 100, Range::positive());
-  const int points = args.get_int("points", 10, Range::closed(1, 1000));
+  const int points = args.get_int("points", 10, Range::closed(2, 1000));
   const int episodes = args.get_int("episodes", recipe.eval_episodes, Range::positive());
   const int seed = args.get_int("seed", 0, Range::non_negative());
   const int threads = resolve_threads(args.get_int("threads", 0, Range::closed(0, kMaxThreads)));
