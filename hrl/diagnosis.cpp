@@ -14,44 +14,23 @@ namespace segue {
 HandOverRates handover_rates(SwitchInterval& interval, const Policy* q_ab, int points) {
   HandOverRates r;
   r.starts = interval.starts();
-  std::vector<float> obs(interval.obs_dim()), q(2);
-  std::vector<std::vector<double>> path;  // the full state at each step of pi_ab's run
-  std::vector<int> judged;                // pi_b's outcome from each point: -1 not yet tried
+  SwitchInterval::Path path;
+  std::vector<int> judged;  // pi_b's outcome from each point: -1 not yet tried
   int q_counted = 0;
   double q_won = 0, q_progress = 0;
   for (int i = 0; i < interval.starts(); ++i) {
-    interval.begin(i, obs.data());
-    path.clear();
-    int q_at = -1, steps = 0;
-    bool fell = false;
-    for (int t = 0;; ++t) {
-      path.emplace_back();
-      interval.save_state(path.back());
-      if (q_ab && q_at < 0) {
-        q_ab->act(obs.data(), 1, q.data());
-        if (q[1] > q[0]) q_at = t;
-      }
-      const SwitchInterval::Stay s = interval.stay(obs.data(), t, obs.data());
-      steps = t + 1;
-      if ((fell = s == SwitchInterval::Stay::Fell)) break;
-      if (s == SwitchInterval::Stay::Ended) {  // the forced switch's state
-        path.emplace_back();
-        interval.save_state(path.back());
-        break;
-      }
-    }
-    const int last = int(path.size()) - 1;
-    if (q_ab && q_at < 0 && !fell) q_at = last;  // the forced switch
-    judged.assign(path.size(), -1);
+    interval.walk(i, q_ab, path);
+    const int last = int(path.states.size()) - 1;
+    int q_at = -1;  // q_ab's hand-over: its first switch, else the forced one (+inf)
+    for (int k = 0; k < int(path.gap.size()) && q_at < 0; ++k)
+      if (path.gap[k] > 0) q_at = k;
+    judged.assign(path.states.size(), -1);
     auto judge = [&](int k) {
-      if (judged[k] < 0) {
-        interval.restore_state(path[k], obs.data());
-        judged[k] = interval.hand_over(obs.data());
-      }
+      if (judged[k] < 0) judged[k] = interval.hand_over_at(path, size_t(k));
       return judged[k] == 1;
     };
     r.at_start += judge(0);
-    if (!fell) r.at_end += judge(last);
+    if (!path.fell) r.at_end += judge(last);
     bool won = false;
     for (int j = 0; j < points && !won; ++j)
       won |= judge(points == 1 ? 0 : int(std::lround(double(j) * last / (points - 1))));
@@ -59,11 +38,11 @@ HandOverRates handover_rates(SwitchInterval& interval, const Policy* q_ab, int p
       const bool ok = judge(q_at);
       q_won += ok;
       won |= ok;
-      if (!fell) q_progress += double(q_at) / std::max(last, 1), ++q_counted;
+      if (!path.fell) q_progress += double(q_at) / std::max(last, 1), ++q_counted;
     }
     r.oracle += won;
-    r.fell += fell;
-    r.interval_steps += steps;
+    r.fell += path.fell;
+    r.interval_steps += path.steps;
   }
   const double n = std::max(1, r.starts);
   r.at_start /= n, r.at_end /= n, r.oracle /= n, r.fell /= n, r.interval_steps /= n;

@@ -1,5 +1,7 @@
 #include "hrl/switch_interval.h"
 
+#include <limits>
+
 namespace segue {
 
 bool run_subtask(Env& env, TransitionController& after, int to, float* obs, int lookahead, int max_steps,
@@ -31,6 +33,8 @@ SwitchInterval::SwitchInterval(const EnvFactory& make_env, const std::vector<Ski
       lookahead_(lookahead),
       max_subtask_steps_(max_subtask_steps),
       act_(env_->spec().act_dim),
+      obs_(env_->spec().obs_dim),
+      q_(2),
       features_(env_->spec().feature_names.size()) {}
 
 void SwitchInterval::begin(int i, float* obs) {
@@ -50,6 +54,34 @@ SwitchInterval::Stay SwitchInterval::stay(const float* obs, int t, float* next_o
 
 bool SwitchInterval::hand_over(float* obs) {
   return run_subtask(*env_, after_, to_, obs, lookahead_, max_subtask_steps_, &env_steps_);
+}
+
+void SwitchInterval::walk(int i, const Policy* q_ab, Path& path) {
+  path.states.clear(), path.gap.clear();
+  path.fell = false;
+  begin(i, obs_.data());
+  for (int t = 0;; ++t) {
+    path.states.emplace_back();
+    env_->save_state(path.states.back());
+    if (q_ab) {
+      q_ab->act(obs_.data(), 1, q_.data());
+      path.gap.push_back(q_[1] - q_[0]);
+    }
+    const Stay s = stay(obs_.data(), t, obs_.data());
+    path.steps = t + 1;
+    if ((path.fell = s == Stay::Fell)) return;  // no hand-over point after this one
+    if (s == Stay::Ended) {
+      path.states.emplace_back();
+      env_->save_state(path.states.back());
+      if (q_ab) path.gap.push_back(std::numeric_limits<float>::infinity());
+      return;
+    }
+  }
+}
+
+bool SwitchInterval::hand_over_at(const Path& path, size_t k) {
+  env_->restore_state(path.states[k], obs_.data());
+  return hand_over(obs_.data());
 }
 
 }  // namespace segue

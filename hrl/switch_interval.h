@@ -48,8 +48,18 @@ class SwitchInterval {
   Stay stay(const float* obs, int t, float* next_obs);
   // pi_b takes over at the current state (obs, updated in place): does it achieve its subtask?
   bool hand_over(float* obs);
-  void save_state(std::vector<double>& state) const { env_->save_state(state); }
-  void restore_state(const std::vector<double>& state, float* obs) { env_->restore_state(state, obs); }
+  // pi_ab's whole run through the interval from S_a's state i: the full state at each of its
+  // steps, then the forced switch's state unless pi_ab fell; with q_ab, Q(switch) - Q(stay)
+  // at each of them (+inf at the forced switch's, where control passes anyway).
+  struct Path {
+    std::vector<std::vector<double>> states;
+    std::vector<float> gap;  // empty without q_ab
+    bool fell = false;
+    int steps = 0;  // pi_ab's
+  };
+  void walk(int i, const Policy* q_ab, Path& path);
+  // pi_b takes over at the path's state k: does it achieve its subtask?
+  bool hand_over_at(const Path& path, size_t k);
   // Environment steps so far: pi_ab's and pi_b's.
   int64_t env_steps() const { return env_steps_; }
 
@@ -62,7 +72,7 @@ class SwitchInterval {
   TransitionController after_;  // judges a hand-over: pi_b, then With TP (run_subtask)
   int lookahead_, max_subtask_steps_;
   int64_t env_steps_ = 0;
-  std::vector<float> act_;
+  std::vector<float> act_, obs_, q_;
   std::vector<double> features_, state_;
 };
 
