@@ -2,6 +2,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <thread>
 
 #include "algorithms/gae.h"
 #include "core/error.h"
@@ -19,6 +21,7 @@ void OnPolicyConfig::read_rollout(const Section& s) {
   min_log_std = s.get("min_log_std", min_log_std, Range::any());
   normalize_reward = s.get("normalize_reward", normalize_reward);
   obs_clip = s.get("obs_clip", obs_clip, Range::positive());
+  policy_lag = s.get("policy_lag", policy_lag, Range::closed(0, 1));
 }
 
 OnPolicyLearner::OnPolicyLearner(std::string name, const OnPolicyConfig& config, const ActorCriticSpec& net,
@@ -32,11 +35,15 @@ OnPolicyLearner::OnPolicyLearner(std::string name, const OnPolicyConfig& config,
     if (global_envs_ != rollout_cfg_.num_envs)
       throw Error(name_ + ": the ranks step " + std::to_string(global_envs_) + " environments in all, " + name_ +
                   ".num_envs is " + std::to_string(rollout_cfg_.num_envs));
+    if (rollout_cfg_.policy_lag > 0)
+      throw Error(name_ + ".policy_lag: 1 overlaps one process's rollout and update; a data-parallel run (" +
+                  std::to_string(group_.size()) + " ranks) takes policy_lag 0");
   }
   torch::manual_seed(mix_seed(seed, 0x5e9e));
   net_ = ActorCritic(net);
   if (!net.ignore_obs.empty()) obs_rms_.ignore(net.ignore_obs.at(0), net.ignore_obs.at(1));
   buf_.resize(rollout_cfg_.steps_per_env, envs.size(), net.obs_dim, net.act_dim, net.in_dim());
+  if (rollout_cfg_.policy_lag > 0) next_buf_ = buf_;
   running_return_.assign(envs.size(), 0.0);
   mean_.resize(size_t(envs.size()) * net.act_dim);
   env_rng_.resize(envs.size());
@@ -84,67 +91,111 @@ void OnPolicyLearner::refresh_inference_copy() {
 }
 
 IterationStats OnPolicyLearner::iterate() {
+  using Clock = std::chrono::steady_clock;
   IterationStats stats;
-  // Per-iteration seeds make a resumed run draw the same noise as an uninterrupted one.
-  const uint64_t noise_seed = mix_seed(seed_, 2 * iteration_ + 1);
-  for (int i = 0; i < envs_.size(); ++i) env_rng_[i].seed(mix_seed(noise_seed, uint64_t(envs_.first_index() + i)));
-  torch::manual_seed(mix_seed(seed_, 2 * iteration_ + 2));
-  auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   const double comm0 = group_.comm_seconds();
-  collect_rollout(stats);
-  auto t1 = std::chrono::steady_clock::now();
-  update(stats);
-  auto t2 = std::chrono::steady_clock::now();
+  envs_.finished().clear();
+  if (!rollout_ready_) {  // policy_lag 0, or the first rollout of a lagged run
+    collect_steps(iteration_, buf_);
+    finish_rollout(iteration_);
+  }
+  const auto t1 = Clock::now();
   stats.rollout_seconds = std::chrono::duration<double>(t1 - t0).count();
+  // policy_lag 1: the next rollout is collected beside this update, by the policy that
+  // collected this one; it is not collected after the last update.
+  const bool ahead = rollout_cfg_.policy_lag > 0 && iteration_ + 1 < total_iterations();
+  std::thread collector;
+  std::exception_ptr collector_error;
+  double ahead_seconds = 0.0;
+  if (ahead)
+    collector = std::thread([&] {
+      try {
+        const auto a = Clock::now();
+        collect_steps(iteration_ + 1, next_buf_);
+        ahead_seconds = std::chrono::duration<double>(Clock::now() - a).count();
+      } catch (...) {
+        collector_error = std::current_exception();
+      }
+    });
+  try {
+    update(stats);
+  } catch (...) {
+    if (collector.joinable()) collector.join();
+    throw;
+  }
+  const auto t2 = Clock::now();
+  if (collector.joinable()) collector.join();
+  if (collector_error) std::rethrow_exception(collector_error);
+  refresh_inference_copy();
   stats.update_seconds = std::chrono::duration<double>(t2 - t1).count();
+  stats.rollout_seconds += ahead_seconds;
+  rollout_ready_ = ahead;
+  if (ahead) {
+    std::swap(buf_, next_buf_);
+    finish_rollout(iteration_ + 1);
+  }
+  episode_stats(stats);
   stats.comm_seconds = group_.comm_seconds() - comm0;
   ++iteration_;
   global_step_ += int64_t(buf_.T) * global_envs_;
-  wall_seconds_ += stats.rollout_seconds + stats.update_seconds;
+  wall_seconds_ += std::chrono::duration<double>(Clock::now() - t0).count();
   stats.iteration = iteration_;
   stats.global_step = global_step_;
   return stats;
 }
 
-void OnPolicyLearner::sample_actions(int t) {
-  const int N = buf_.N, A = buf_.act_dim;
-  float* obs = buf_.obs_at(t);
-  float* act = buf_.actions_at(t);
+void OnPolicyLearner::sample_actions(RolloutBuffer& buf, int t) {
+  const int N = buf.N, A = buf.act_dim;
+  float* obs = buf.obs_at(t);
+  float* act = buf.actions_at(t);
   actor_copy_.forward(obs, N, mean_.data());
   for (int i = 0; i < N; ++i) {
     float* a = act + size_t(i) * A;
     const float* mu = &mean_[size_t(i) * A];
     for (int j = 0; j < A; ++j) a[j] = mu[j] + std::exp(log_std_[j]) * static_cast<float>(env_rng_[i].normal());
-    buf_.log_probs[size_t(t) * N + i] = static_cast<float>(gaussian_log_prob(a, mu, log_std_.data(), A));
+    buf.log_probs[size_t(t) * N + i] = static_cast<float>(gaussian_log_prob(a, mu, log_std_.data(), A));
   }
 }
 
 void OnPolicyLearner::collect_rollout(IterationStats& stats) {
-  const int T = buf_.T, N = buf_.N, D = buf_.obs_dim, I = buf_.in_dim;
-  buf_.truncated_index.clear();
-  buf_.truncated_obs.clear();
   envs_.finished().clear();
+  collect_steps(iteration_, buf_);
+  finish_rollout(iteration_);
+  episode_stats(stats);
+}
+
+void OnPolicyLearner::collect_steps(int64_t iteration, RolloutBuffer& buf) {
+  // Per-iteration seeds make a resumed run draw the same noise as an uninterrupted one.
+  const uint64_t noise_seed = mix_seed(seed_, 2 * iteration + 1);
+  for (int i = 0; i < envs_.size(); ++i) env_rng_[i].seed(mix_seed(noise_seed, uint64_t(envs_.first_index() + i)));
+  const int T = buf.T, N = buf.N, D = buf.obs_dim, I = buf.in_dim;
+  buf.truncated_index.clear();
+  buf.truncated_obs.clear();
   for (int t = 0; t < T; ++t) {
-    std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf_.raw_obs_at(t));
+    std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf.raw_obs_at(t));
     for (int i = 0; i < N; ++i)
-      net_input(buf_.raw_obs_at(t) + size_t(i) * D, buf_.obs_at(t) + size_t(i) * I);
-    sample_actions(t);
-    envs_.step(buf_.actions_at(t));
-    std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf_.next_raw_obs_at(t));
+      net_input(buf.raw_obs_at(t) + size_t(i) * D, buf.obs_at(t) + size_t(i) * I);
+    sample_actions(buf, t);
+    envs_.step(buf.actions_at(t));
+    std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf.next_raw_obs_at(t));
     for (int i = 0; i < N; ++i) {
       size_t k = size_t(t) * N + i;
       if (envs_.terminated()[i] || envs_.truncated()[i])  // obs() already holds the next episode's start
         std::copy(envs_.final_obs() + size_t(i) * D, envs_.final_obs() + size_t(i + 1) * D,
-                  buf_.next_raw_obs_at(t) + size_t(i) * D);
-      buf_.raw_rewards[k] = envs_.reward()[i];
-      buf_.dones[k] = envs_.terminated()[i] || envs_.truncated()[i];
+                  buf.next_raw_obs_at(t) + size_t(i) * D);
+      buf.raw_rewards[k] = envs_.reward()[i];
+      buf.dones[k] = envs_.terminated()[i] || envs_.truncated()[i];
       if (envs_.truncated()[i] && !envs_.terminated()[i]) {
-        buf_.truncated_index.push_back(static_cast<int>(k));
-        buf_.truncated_obs.resize(buf_.truncated_obs.size() + I);
-        net_input(envs_.final_obs() + size_t(i) * D, &buf_.truncated_obs[buf_.truncated_obs.size() - I]);
+        buf.truncated_index.push_back(static_cast<int>(k));
+        buf.truncated_obs.resize(buf.truncated_obs.size() + I);
+        net_input(envs_.final_obs() + size_t(i) * D, &buf.truncated_obs[buf.truncated_obs.size() - I]);
       }
     }
   }
+}
+
+void OnPolicyLearner::episode_stats(IterationStats& stats) {
   // Episode statistics over every rank, in the task's own reward units.
   double totals[5] = {double(envs_.finished().size()), 0, 0, 0, 0};
   for (const auto& e : envs_.finished())
@@ -157,7 +208,13 @@ void OnPolicyLearner::collect_rollout(IterationStats& stats) {
     stats.success_rate = totals[3] / totals[0];
     stats.success_count = totals[4] / totals[0];
   }
+}
 
+void OnPolicyLearner::finish_rollout(int64_t iteration) {
+  const int T = buf_.T, N = buf_.N, D = buf_.obs_dim, I = buf_.in_dim;
+  // A reward hook (and anything else drawing from LibTorch's generator) sees the same
+  // draws whichever iteration collected the rollout.
+  torch::manual_seed(mix_seed(seed_, 2 * iteration + 2));
   if (reward_hook_) reward_hook_(buf_);
   // The scale of rewards: the std of the discounted return, tracked per environment and
   // pooled over the rollout (and the ranks).

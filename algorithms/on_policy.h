@@ -7,6 +7,7 @@
 
 #include <functional>
 #include <memory>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,11 @@ struct OnPolicyConfig {
   double min_log_std = -20.0;       // -20: no floor
   bool normalize_reward = true;     // scale rewards by the std of the discounted return
   double obs_clip = 10.0;           // normalised observations are clipped to +-obs_clip
+  // 1: the environments collect the next rollout while the learner updates on this one, so
+  // the update is off the rollout's critical path. That rollout is collected by the policy
+  // before the update (one iteration of lag), which the ratio and surrogate account for:
+  // they use the log-probabilities of the policy that acted. One process only.
+  int policy_lag = 0;
 
   // Reads the keys above from `s`, over the values already set.
   void read_rollout(const Section& s);
@@ -55,10 +61,16 @@ class OnPolicyLearner : public Learner {
                   uint64_t seed, const Distributed& group);
   const std::string& name() const override { return name_; }  // "ppo" or "trpo"
 
-  // One rollout of rollout_size() steps, then update(). Throws segue::Error if the loss or
-  // the rewards stop being finite.
+  // One update on a rollout of rollout_size() steps. With policy_lag 0 the rollout is
+  // collected first, by the current policy; with 1, the rollout the previous iteration
+  // collected beside its update is used, and the next one is collected beside this one.
+  // Throws segue::Error if the loss or the rewards stop being finite.
   IterationStats iterate() override;
+  // Collects a rollout with the current policy and turns it into advantages (what
+  // iterate() does before update() with policy_lag 0).
   void collect_rollout(IterationStats& stats);
+  // One update on the collected rollout; the rollout's policy copy follows at the next
+  // refresh (iterate() does it once the environments stop reading it).
   virtual void update(IterationStats& stats) = 0;
 
   // Replaces the environment's rewards after a rollout is collected and before they are
@@ -146,8 +158,17 @@ class OnPolicyLearner : public Learner {
 
  private:
   void read_state(torch::serialize::InputArchive& ar, const std::string& path, bool same_run);  // load()'s body
+  // policy_lag 1: what an update reads of a rollout collected but not yet used, by name.
+  std::vector<std::pair<std::string, std::vector<float>*>> pending_rollout() const;
+  bool read_pending_rollout(torch::serialize::InputArchive& ar, const std::string& path);
   struct InFlight;
-  void sample_actions(int t);
+  // A rollout in two parts: the environment steps, which read only the policy's Eigen copy
+  // and the observation normaliser (and so can run beside an update), then what needs the
+  // networks: rewards scaled, values, GAE advantages, the normalisers updated.
+  void collect_steps(int64_t iteration, RolloutBuffer& buf);
+  void finish_rollout(int64_t iteration);
+  void episode_stats(IterationStats& stats);
+  void sample_actions(RolloutBuffer& buf, int t);
   // The networks' input for one raw observation: normalised, then the periodic features.
   void net_input(const float* raw, float* out) const;
 
@@ -161,6 +182,10 @@ class OnPolicyLearner : public Learner {
   std::vector<float> mean_, log_std_;
   RewardHook reward_hook_;
   double wall_seconds_ = 0.0;
+  // policy_lag 1: the rollout being collected beside an update, and whether buf_ holds a
+  // collected rollout that no update has used yet (saved with a checkpoint).
+  RolloutBuffer next_buf_;
+  bool rollout_ready_ = false;
 };
 
 }  // namespace segue

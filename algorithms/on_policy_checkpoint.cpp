@@ -106,6 +106,9 @@ void OnPolicyLearner::save(const std::string& path, const std::string& note, con
       all.append(group_.single() ? mine : InFlight::from_bytes(part));
     all.write(ar);
   }
+  // policy_lag 1: the rollout collected beside the last update, which the next one uses.
+  if (rollout_ready_)
+    for (const auto& [name, rows] : pending_rollout()) ar.write(name, torch::from_blob(rows->data(), {int64_t(rows->size())}).clone());
   if (!group_.leader()) return;
   std::ostringstream bytes;
   ar.save_to(bytes);
@@ -134,6 +137,8 @@ void OnPolicyLearner::load(const std::string& path, const ArchiveReader& extra, 
     if (extra) extra(ar);
     read_state(ar, path, resume_episodes);
     in_flight = resume_episodes && saved.read(ar);
+    rollout_ready_ = false;
+    if (resume_episodes && rollout_cfg_.policy_lag > 0) rollout_ready_ = read_pending_rollout(ar, path);
   } catch (const c10::Error& e) {
     std::string what = e.what_without_backtrace();
     throw Error(path + ": unreadable checkpoint: " + what.substr(0, what.find('\n')));
@@ -199,6 +204,30 @@ void OnPolicyLearner::read_state(torch::serialize::InputArchive& ar, const std::
   global_step_ = counters[1].item<int64_t>();
   wall_seconds_ = counters[2].item<int64_t>() / 1000.0;
   schedule_start_ = counters.numel() > 3 ? counters[3].item<int64_t>() : 0;  // older checkpoints: 0
+}
+
+std::vector<std::pair<std::string, std::vector<float>*>> OnPolicyLearner::pending_rollout() const {
+  auto& b = const_cast<RolloutBuffer&>(buf_);  // save() only reads them
+  return {{"pending_obs", &b.obs}, {"pending_actions", &b.actions}, {"pending_log_probs", &b.log_probs},
+          {"pending_advantages", &b.advantages}, {"pending_returns", &b.returns}};
+}
+
+bool OnPolicyLearner::read_pending_rollout(torch::serialize::InputArchive& ar, const std::string& path) {
+  const auto parts = pending_rollout();
+  for (size_t i = 0; i < parts.size(); ++i) {
+    torch::Tensor t;
+    if (!ar.try_read(parts[i].first, t)) {
+      if (i == 0) return false;  // saved between rollouts (or with policy_lag 0)
+      throw Error(path + ": its pending rollout lacks '" + parts[i].first + "'");
+    }
+    std::vector<float>& rows = *parts[i].second;
+    if (t.numel() != int64_t(rows.size()))
+      throw Error(path + ": its pending rollout has " + std::to_string(t.numel()) + " values of '" + parts[i].first +
+                  "', the recipe's rollout " + std::to_string(rows.size()));
+    t = t.to(torch::kFloat32).contiguous();
+    std::copy(t.data_ptr<float>(), t.data_ptr<float>() + t.numel(), rows.begin());
+  }
+  return true;
 }
 
 Policy OnPolicyLearner::policy_from_checkpoint(torch::serialize::InputArchive& ar) {

@@ -113,7 +113,6 @@ void PPO::update(IterationStats& stats) {
   stats.approx_kl = sums[2] / batches;
   stats.clip_fraction = sums[3] / batches;
   stats.entropy = net_->entropy().item<double>();
-  refresh_inference_copy();
 }
 
 }  // namespace segue

@@ -38,7 +38,6 @@ void TRPO::update(IterationStats& stats) {
   policy_step(stats);
   fit_value(stats);
   stats.entropy = net_->entropy().item<double>();
-  refresh_inference_copy();
 }
 
 void TRPO::policy_step(IterationStats& stats) {

@@ -318,9 +318,11 @@ std::vector<YAML::Node> Recipe::stages() const {
   return out;
 }
 
-Recipe Recipe::with_overrides(const YAML::Node& overrides, const std::string& name) const {
+Recipe Recipe::with_overrides(const YAML::Node& overrides, const std::string& name,
+                              const std::vector<std::string>& without) const {
   YAML::Node tree = YAML::Clone(s_->tree);
   tree.remove("stages");
+  for (const auto& key : without) tree.remove(key);
   if (overrides.IsMap()) merge_into(tree, overrides);
   YAML::Emitter e;
   e << tree;

@@ -118,9 +118,11 @@ class Recipe {
   const std::map<std::string, KeyRule>& key_rules() const;
   // The recipe's `stages:` list (a curriculum), each item as written (empty: none).
   std::vector<YAML::Node> stages() const;
-  // This recipe without its stages, with `overrides` laid over it (mappings merged key by
-  // key, any other value replaced): one stage of a curriculum, named `name` in errors.
-  Recipe with_overrides(const YAML::Node& overrides, const std::string& name) const;
+  // This recipe without its stages and its top-level keys `without`, with `overrides` laid
+  // over it (mappings merged key by key, any other value replaced): one stage of a
+  // curriculum, named `name` in errors.
+  Recipe with_overrides(const YAML::Node& overrides, const std::string& name,
+                        const std::vector<std::string>& without = {}) const;
 
  private:
   explicit Recipe(std::shared_ptr<Section::State> s) : s_(std::move(s)) {}

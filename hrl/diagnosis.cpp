@@ -7,6 +7,7 @@
 #include <tuple>
 
 #include "core/assets.h"
+#include "environments/registry.h"
 #include "hrl/collection.h"
 
 namespace segue {
@@ -51,6 +52,28 @@ HandOverRates handover_rates(SwitchInterval& interval, const Policy* q_ab, int p
   return r;
 }
 
+SkillAlone skill_alone(const Skill& skill, int episodes, uint64_t seed, int threads) {
+  SkillAlone a{skill.name, skill.task};
+  if (skill.task.empty()) return a;
+  // The walker's sub-tasks push the walker by default (the reference trains them so); the
+  // composite tasks never do, so the skill runs push-free where its task pushes.
+  Recipe settings = Recipe::parse("{push_prob: 0}", "push-free " + skill.task);
+  EnvFactory own = task_factory(skill.task, settings.root());
+  try {
+    settings.reject_unknown();
+  } catch (const Error&) {
+    own = reference_task_factory(skill.task);  // a task without pushes
+  }
+  const EnvSpec spec = own()->spec();
+  if (spec.obs_dim != skill.policy.obs_dim() || spec.act_dim != skill.policy.act_dim())
+    throw Error("key 'skills." + skill.name + ".task': task '" + skill.task + "' observes " +
+                std::to_string(spec.obs_dim) + " numbers, skill '" + skill.name + "''s policy " +
+                std::to_string(skill.policy.obs_dim()));
+  a.episodes = episodes;
+  a.success = evaluate_policy(skill.policy, own, episodes, seed, threads).success_rate();
+  return a;
+}
+
 std::vector<EpisodeEnd> episode_ends(const EvalResult& e) {
   std::map<std::tuple<std::string, int, std::string>, int> counts;
   for (size_t i = 0; i < e.returns.size(); ++i) {
@@ -86,6 +109,11 @@ Diagnosis diagnose(const CompositeRecipe& r, const std::string& method, int star
     h.transition = r.transition_name(t);
     d.transitions.push_back(h);
   }
+  for (const Skill& k : r.skills) try {
+      d.skills.push_back(skill_alone(k, starts, seed, threads));
+    } catch (const Error& e) {
+      throw Error(r.file + ": " + e.what());
+    }
   EvalResult all;
   const ControllerFactory controllers = method_controllers(r, method);
   for (int s : r.eval_seeds) all.append(evaluate(r.make_env, controllers, episodes, uint64_t(s), threads));
@@ -120,6 +148,15 @@ std::string diagnosis_text(const Diagnosis& d) {
     o << line;
   }
   o << "  (q_ab at: where q_ab hands over, 0 at the interval's start, 1 at its end)\n";
+  o << "each skill alone from its own start (its own task, push-free; share that succeed)\n";
+  for (const SkillAlone& a : d.skills) {
+    if (a.task.empty())
+      std::snprintf(line, sizeof line, "  %-22s %-16s %9s\n", a.skill.c_str(), "(no task)", "-");
+    else
+      std::snprintf(line, sizeof line, "  %-22s %-16s %9.2f  (%d episodes)\n", a.skill.c_str(), a.task.c_str(),
+                    a.success, a.episodes);
+    o << line;
+  }
   std::snprintf(line, sizeof line, "%s's %d evaluation episodes (mean success count %.2f) ended:\n", d.method.c_str(),
                 d.episodes, d.success_count_mean);
   o << line;
@@ -142,6 +179,12 @@ std::string diagnosis_json(const Diagnosis& d) {
       << ", \"at_start\": " << num(h.at_start) << ", \"at_end\": " << num(h.at_end) << ", \"with_q\": " << num(h.with_q)
       << ", \"oracle\": " << num(h.oracle) << ", \"pi_ab_fell\": " << num(h.fell)
       << ", \"q_progress\": " << num(h.q_progress) << ", \"interval_steps\": " << num(h.interval_steps, 1) << "}";
+  }
+  o << "], \"skills\": [";
+  for (size_t i = 0; i < d.skills.size(); ++i) {
+    const SkillAlone& a = d.skills[i];
+    o << (i ? ", " : "") << "{\"skill\": \"" << a.skill << "\", \"task\": \"" << a.task
+      << "\", \"episodes\": " << a.episodes << ", \"success\": " << num(a.success) << "}";
   }
   o << "], \"episodes\": " << d.episodes << ", \"success_count_mean\": " << num(d.success_count_mean)
     << ", \"ends\": [";

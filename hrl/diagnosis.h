@@ -9,6 +9,8 @@
 //   where q_ab switches           With TP + Q;
 //   at the best of several points along pi_ab's path, in hindsight (q_ab's among them):
 //                                 what a better switch could reach with this pi_ab.
+// Each skill alone from its own start: its own task (the reference's settings, push-free
+// as the composite tasks run), the success rate of its deterministic policy.
 // And over the method's evaluation episodes (the recipe's seeds, as `segue report` runs
 // them): who was in control when each episode ended, at which success count, and how.
 #include <string>
@@ -36,6 +38,15 @@ struct HandOverRates {
 // them) and q_ab's, and counts a start as won when any of them succeeds.
 HandOverRates handover_rates(SwitchInterval& interval, const Policy* q_ab, int points);
 
+struct SkillAlone {
+  std::string skill, task;  // task "": the skill names none (Skill::task)
+  int episodes = 0;
+  double success = -1;      // -1: not run
+};
+
+// `skill` alone on its own task, `episodes` episodes from `seed`.
+SkillAlone skill_alone(const Skill& skill, int episodes, uint64_t seed, int threads);
+
 struct EpisodeEnd {
   std::string in_control;  // a skill, or "a->b" while a transition policy drove
   int success_count = 0;
@@ -46,6 +57,7 @@ struct EpisodeEnd {
 struct Diagnosis {
   std::string task, method;
   std::vector<HandOverRates> transitions;
+  std::vector<SkillAlone> skills;
   int episodes = 0;  // evaluation episodes, all seeds
   double success_count_mean = 0;
   std::vector<EpisodeEnd> ends;  // most frequent first
@@ -54,9 +66,9 @@ struct Diagnosis {
 // Episodes grouped by how they ended, most frequent first.
 std::vector<EpisodeEnd> episode_ends(const EvalResult& result);
 
-// Both parts on the recipe's shipped (or --recipe's) artefacts: `starts` states of S_a per
-// transition collected from `seed`, and the method's evaluation at `episodes` per seed of
-// the recipe's eval.seeds.
+// Every part on the recipe's shipped (or --recipe's) artefacts: `starts` states of S_a per
+// transition collected from `seed` (and as many episodes of each skill alone), and the
+// method's evaluation at `episodes` per seed of the recipe's eval.seeds.
 Diagnosis diagnose(const CompositeRecipe& recipe, const std::string& method, int starts, int points,
                    int episodes, uint64_t seed, int threads);
 

@@ -14,10 +14,13 @@ struct Skill {
   std::string policy_path;
   Policy policy;
   int obs_begin = 0, obs_end = 0;  // [begin, end) of the task observation
+  // Its own task, where `segue diagnose` runs it alone: `task:`, by default the policy
+  // file's name where that names a task (walker_jump.pt); "" when neither does.
+  std::string task;
 };
 
-// Reads the `skills:` mapping  name: {policy: FILE, obs: [begin, end]}  (obs defaults to
-// the first policy.obs_dim() numbers). Refuses missing files and sizes that do not fit.
+// Reads the `skills:` mapping  name: {policy: FILE, obs: [begin, end], task: NAME}  (obs
+// defaults to the first policy.obs_dim() numbers). Refuses missing files and sizes that do not fit.
 std::vector<Skill> read_skills(const Section& skills, const EnvSpec& task);
 int skill_index(const std::vector<Skill>& skills, const std::string& name);  // -1 if absent
 

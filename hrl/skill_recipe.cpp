@@ -31,8 +31,8 @@ SkillRecipe SkillRecipe::read(const Recipe& recipe, const std::string& default_r
   s.net.activation = parse_activation(pol.choice("activation", "tanh", {"tanh", "relu"}));
   s.net.init_log_std = pol.get("init_log_std", s.net.init_log_std, Range::any());
   s.net.ignore_obs = pol.get("ignore_obs", s.net.ignore_obs, Range::non_negative());
-  s.learner = root.choice("learner", s.learner, {"ppo", "trpo", "sac"});
-  for (const std::string other : {"ppo", "trpo", "sac"})
+  s.learner = root.choice("learner", s.learner, {kLearners.begin(), kLearners.end()});
+  for (const std::string other : kLearners)
     if (other != s.learner && root.has(other))
       throw root.error(other, "applies to learner: " + other + " (the recipe's learner is " + s.learner + ")");
   if (s.learner == "ppo") s.ppo = PpoConfig::read(root.sub("ppo"));

@@ -29,6 +29,7 @@
 // eval.reference_task: judge the trained skill on the task with every env key at its
 // reference value (a recipe may train on an easier or reshaped version, e.g. a curb
 // curriculum, and must still be measured on the reference's task).
+#include <array>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -80,6 +81,9 @@ struct SkillRecipe {
   // the recipe names none.
   static SkillRecipe read(const Recipe& recipe, const std::string& default_run_dir);
 };
+
+// The values of `learner:`, each also the name of its settings' section.
+inline const std::array<const char*, 3> kLearners = {"ppo", "trpo", "sac"};
 
 // The recipe's learner on `envs` (its share of num_envs where `group` has several ranks).
 std::unique_ptr<Learner> make_learner(const SkillRecipe& s, VectorEnv& envs, const Distributed& group);

@@ -180,7 +180,13 @@ int train_stages(const Recipe& recipe, const std::string& default_run_dir, bool 
       ov[stages[i].from_policy ? "init_from" : "init_policy"] = "";
     }
     if (total_steps > 0) ov[learner]["total_steps"] = total_steps;
-    return recipe.with_overrides(ov, recipe.file() + " (stage " + stages[i].name + ")");
+    // A stage that names its learner takes that learner's settings only: the file's
+    // sections for the others (its PPO settings, say, under a TRPO stage) stay behind.
+    std::vector<std::string> without;
+    if (ov["learner"].IsDefined())
+      for (const std::string other : kLearners)
+        if (other != ov["learner"].Scalar()) without.push_back(other);
+    return recipe.with_overrides(ov, recipe.file() + " (stage " + stages[i].name + ")", without);
   };
   // Every stage is read and checked before the first step of the first. The curriculum's
   // ETA: each stage's line at one rate per step, from 0 where it continues a checkpoint.

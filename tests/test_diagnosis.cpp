@@ -1,6 +1,7 @@
 // segue diagnose (hrl/diagnosis.h): the hand-over rates equal a by-hand replay from the
-// same S_a states with the shipped forward->balance pi_ab and q_ab, and the evaluation
-// episodes it groups are report's, episode for episode.
+// same S_a states with the shipped forward->balance pi_ab and q_ab, each skill alone is
+// its own task's push-free evaluation, and the evaluation episodes it groups are
+// report's, episode for episode.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <vector>
 
 #include "core/assets.h"
+#include "environments/registry.h"
 #include "hrl/collection.h"
 #include "hrl/diagnosis.h"
 #include "tests/transition_fixture.h"
@@ -125,6 +127,37 @@ TEST_F(TransitionTraining, DiagnosisGroupsReportsEpisodesByHowTheyEnded) {
   const std::string json = diagnosis_json(d);
   EXPECT_NE(json.find("\"transition\": \"forward-balance\""), std::string::npos) << json;
   EXPECT_NE(json.find("\"episodes\": 6"), std::string::npos) << json;
+}
+
+TEST_F(TransitionTraining, EachSkillAloneRunsItsOwnTaskPushFree) {
+  CompositeRecipe r = tiny({"skills.balance.task=walker_balance"});
+  ASSERT_EQ(r.skills.size(), 3u);
+  EXPECT_EQ(r.skills[0].task, "walker_forward");  // named after its policy file
+  EXPECT_EQ(r.skills[2].task, "walker_balance");
+  // The balance alone against its task built here: reference settings, no pushes.
+  const Recipe settings = Recipe::parse("{push_prob: 0}", "push-free");
+  const EvalResult want = evaluate_policy(r.skills[2].policy, task_factory("walker_balance", settings.root()), 6, 3, 1);
+  const SkillAlone a = skill_alone(r.skills[2], 6, 3, 1);
+  EXPECT_EQ(a.task, "walker_balance");
+  EXPECT_EQ(a.episodes, 6);
+  EXPECT_DOUBLE_EQ(a.success, want.success_rate());
+  // With pushes (the task's default) the episodes differ: the setting took effect.
+  const EvalResult pushed = evaluate_policy(r.skills[2].policy, reference_task_factory("walker_balance"), 6, 3, 1);
+  EXPECT_NE(summarize(pushed.returns).mean, summarize(want.returns).mean);
+  // A task the policy does not fit, or no task at all, is refused naming the key.
+  try {
+    CompositeRecipe bad = tiny({"skills.balance.task=walker_jump"});
+    skill_alone(bad.skills[2], 1, 0, 1);
+    ADD_FAILURE() << "a 28-number task for a 26-number policy was run";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("skills.balance.task"), std::string::npos) << e.what();
+  }
+  try {
+    tiny({"skills.balance.task=walker_balanse"});
+    ADD_FAILURE() << "an unknown task was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("skills.balance.task"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace segue

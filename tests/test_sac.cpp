@@ -12,6 +12,7 @@
 #include "hrl/evaluation.h"
 #include "tests/cli_run.h"
 #include "tests/csv.h"
+#include "tests/short_walker.h"
 #include "tests/temp_dir.h"
 
 namespace segue {
@@ -29,17 +30,12 @@ TEST(Sac, SoftTargetMatchesTheHandComputedRows) {
   EXPECT_NEAR(y[2].item<double>(), 0.5, 1e-12);
 }
 
-struct ShortWalker {
-  Recipe recipe = Recipe::parse("{env: {max_episode_steps: 100, success_steps: 100}}", "test");
-  std::function<std::unique_ptr<Env>()> make = task_factory("walker_forward", recipe.root().sub("env"));
-  SacConfig cfg;
-  ActorCriticSpec spec;
+struct ShortWalker : ShortWalkerTask<SacConfig> {
   ShortWalker() {
     cfg.buffer_size = 100000;
     cfg.start_steps = 2000;
     cfg.update_after = 1000;
     cfg.batch_size = 128;
-    spec.obs_dim = 26, spec.act_dim = 6;
     spec.pi_hidden = {64, 64}, spec.vf_hidden = {64, 64};
     spec.activation = Activation::Relu;
   }

@@ -2,6 +2,7 @@
 // continuing the last, each in its own directory, the rows of all in one metrics.csv.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <array>
 #include <fstream>
 #include <sstream>
@@ -131,6 +132,25 @@ TEST_F(Stages, ACurriculumFromAnExportedPolicyContinuesItsOwnCheckpointLater) {
   auto rows = csv(path("run/metrics.csv"));
   ASSERT_EQ(rows.size(), 5u);
   EXPECT_EQ(rows[3][1], "3");  // the checkpoint's counters go on
+}
+
+TEST_F(Stages, AStageMayTrainWithAnotherLearner) {
+  // The file's `ppo:` settings are its PPO stages'; a TRPO stage reads its own section only.
+  ASSERT_EQ(run_segue("train " + recipe(", continue: policy, learner: trpo, trpo: {total_steps: 2048, num_envs: 4, "
+                                        "steps_per_env: 256, vf_minibatch: 256}")),
+            0);
+  const std::string second = read_file(path("run/2-second/recipe.yaml"));
+  EXPECT_NE(second.find("learner: trpo"), std::string::npos) << second;
+  EXPECT_EQ(second.find("ppo:"), std::string::npos) << second;
+  auto rows = csv(path("run/metrics.csv"));
+  ASSERT_EQ(rows.size(), 5u);
+  const auto& header = rows[0];
+  const size_t step_size = std::find(header.begin(), header.end(), "step_size") - header.begin();
+  ASSERT_LT(step_size, header.size()) << "no TRPO column in the stages' metrics";
+  // A row's trailing empty cells may be left out.
+  auto cell = [&](size_t r) { return step_size < rows[r].size() ? rows[r][step_size] : std::string(); };
+  EXPECT_EQ(cell(2), "");  // the PPO stage's rows leave it empty
+  EXPECT_NE(cell(4), "");
 }
 
 }  // namespace segue

@@ -14,22 +14,17 @@
 #include "hrl/evaluation.h"
 #include "tests/cli_run.h"
 #include "tests/csv.h"
+#include "tests/short_walker.h"
 #include "tests/temp_dir.h"
 
 namespace segue {
 namespace {
 
-struct ShortWalker {
-  Recipe recipe = Recipe::parse("{env: {max_episode_steps: 100, success_steps: 100}}", "test");
-  std::function<std::unique_ptr<Env>()> make = task_factory("walker_forward", recipe.root().sub("env"));
-  TrpoConfig cfg;
-  ActorCriticSpec spec;
+struct ShortWalker : ShortWalkerTask<TrpoConfig> {
   ShortWalker() {
     cfg.num_envs = 8;
     cfg.steps_per_env = 256;
     cfg.total_steps = 40 * 2048;
-    spec.obs_dim = 26;
-    spec.act_dim = 6;
     spec.init_log_std = 0.0;
   }
 };

@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
 """Runs `build/segue bench --json` RUNS times (default 3) and prints docs/speed.md's table:
 physics steps per second of bare mj_step replaying the rollouts' own trajectories, the
-rollout with policy inference, and the full PPO loop, on one thread and on every core,
-for the walker and the arm, with the ratios to bare physics.
+rollout with policy inference, and the full PPO and TRPO loops (also with the next rollout
+collected beside each update, policy_lag 1), on one thread and on every core, for the
+walker and the arm, with the ratios to bare physics.
 
 usage: tools/bench_table.py [RUNS]
 """
@@ -25,9 +26,15 @@ for robot, p in (("walker", ""), ("arm", "jaco_")):
         (f"{robot}: bare mj_step replay, 1 thread", p + "bare_sps", None),
         (f"{robot}: rollout + inference, 1 thread", p + "rollout_sps", p + "rollout_vs_bare"),
         (f"{robot}: full PPO loop, 1 thread", p + "ppo_sps", p + "ppo_vs_bare"),
+        (f"{robot}: full TRPO loop, 1 thread", p + "trpo_sps", p + "trpo_vs_bare"),
+        (f"{robot}: PPO, policy_lag 1, 1 stepping thread", p + "ppo_lag_sps", p + "ppo_lag_vs_bare"),
+        (f"{robot}: TRPO, policy_lag 1, 1 stepping thread", p + "trpo_lag_sps", p + "trpo_lag_vs_bare"),
         (f"{robot}: bare replay, all cores", p + "bare_sps_all_cores", None),
         (f"{robot}: rollout, all cores", p + "rollout_sps_all_cores", p + "rollout_vs_bare_all_cores"),
         (f"{robot}: full PPO loop, all cores", p + "ppo_sps_all_cores", p + "ppo_vs_bare_all_cores"),
+        (f"{robot}: full TRPO loop, all cores", p + "trpo_sps_all_cores", p + "trpo_vs_bare_all_cores"),
+        (f"{robot}: PPO, policy_lag 1, all cores", p + "ppo_lag_sps_all_cores", p + "ppo_lag_vs_bare_all_cores"),
+        (f"{robot}: TRPO, policy_lag 1, all cores", p + "trpo_lag_sps_all_cores", p + "trpo_lag_vs_bare_all_cores"),
     ]
 print("| physics steps/s | " + " | ".join(f"run {i + 1}" for i in range(runs)) + " |")
 print("|---|" + "---|" * runs)

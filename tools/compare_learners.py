@@ -7,7 +7,8 @@ same environment-step budget, then one table and one figure.
                                     [--steps N] [--report-only] [--out docs/learner_comparison]
 
 A learner's recipe for a skill: `ppo` is the shipped one, experiments/primitives/SKILL.yaml;
-any other is experiments/learners/SKILL_LEARNER.yaml. Every run is `segue train RECIPE
+any other is experiments/learners/SKILL_LEARNER.yaml. `LEARNER+lag` is LEARNER's recipe with
+its next rollout collected beside each update (`LEARNER.policy_lag=1`). Every run is `segue train RECIPE
 --set seed=S --set run_dir=RUNS/SKILL/LEARNER/seedS` (resumable: rerunning the command
 resumes unfinished runs and skips finished ones); `--steps` sets every run's budget.
 Writes OUT.md (the table: final deterministic success from each run's eval.json, mean and
@@ -38,7 +39,16 @@ class InputError(Exception):
     pass
 
 
+def base(learner):
+    """The learner a variant's recipe is read for, and the settings the variant adds."""
+    if learner.endswith("+lag"):
+        name = learner[:-len("+lag")]
+        return name, ["--set", f"{name}.policy_lag=1"]
+    return learner, []
+
+
 def recipe(skill, learner):
+    learner = base(learner)[0]
     rel = (f"experiments/primitives/{skill}.yaml" if learner == "ppo"
            else f"experiments/learners/{skill}_{learner}.yaml")
     if not os.path.exists(os.path.join(ROOT, rel)):
@@ -55,10 +65,11 @@ def train(skill, learner, seed, args):
     fcntl.flock(lock, fcntl.LOCK_EX)
     if os.path.exists(os.path.join(run_dir, "eval.json")):
         return run_dir
+    name, variant = base(learner)
     cmd = [os.path.join(ROOT, "build", "segue"), "train", recipe(skill, learner), "--set", f"seed={seed}",
-           "--set", f"run_dir={run_dir}", "--threads", str(args.threads)]
+           "--set", f"run_dir={run_dir}", "--threads", str(args.threads)] + variant
     if args.steps:
-        cmd += ["--set", f"{learner}.total_steps={args.steps}"]
+        cmd += ["--set", f"{name}.total_steps={args.steps}"]
     print(" ".join(cmd), flush=True)
     if subprocess.call(cmd, cwd=ROOT) != 0:
         raise InputError(f"training failed: {' '.join(cmd)}")

@@ -14,7 +14,8 @@
   tools/plot.py diagnose DIAGNOSIS.json --out FILE.png
       `segue diagnose --plot`: per transition the share of hand-overs after which pi_b
       succeeds (at the interval's start, at its end, where q_ab switches, at the best point
-      in hindsight), and how the method's evaluation episodes ended.
+      in hindsight) beside pi_b alone from its own start, and how the method's evaluation
+      episodes ended.
 
   tools/plot.py montage FRAME.png ... --out FILE.png [--titles a,b,...]
       Frames from `segue render --frames` side by side, one per panel.
@@ -187,6 +188,15 @@ def diagnosis_chart(path, out):
     for i, (key, label, colour) in enumerate(kinds):
         values = [t[key] if t[key] is not None else math.nan for t in transitions]
         left.bar([x - 0.4 + (i + 0.5) * width for x in xs], values, width, label=label, color=colour)
+    # pi_b alone from its own start (its own task), where the diagnosis measured it.
+    alone = {a["skill"]: a["success"] for a in d.get("skills", []) if a.get("success") is not None}
+    marked = False
+    for x, t in zip(xs, transitions):
+        b = next((k for k in alone if t["transition"].endswith("-" + k)), None)
+        if b is not None:
+            left.hlines(alone[b], x - 0.45, x + 0.45, colors="black", linestyles="dashed",
+                        label=None if marked else "pi_b alone, its own start")
+            marked = True
     left.set_xticks(list(xs))
     left.set_xticklabels([t["transition"] for t in transitions], rotation=20 if len(transitions) > 3 else 0)
     left.set_ylim(0, 1.05)

@@ -31,7 +31,8 @@ const Command kBench{
     "counts, episode resets included). The framework's own overhead is measured against\n"
     "bare mj_step on the same trajectories: the rollout's controls (and pushes) are\n"
     "recorded and replayed through mj_step alone. Reported: rollout with policy inference,\n"
-    "the full PPO loop (rollout and update), and the bare replay, on one thread and on every\n"
+    "the full PPO and TRPO loops (rollout and update; also with the next rollout collected\n"
+    "beside each update, policy_lag 1), and the bare replay, on one thread and on every\n"
     "core, with each robot's skill recipe (walker_forward, jaco_pick); data-parallel PPO\n"
     "on 1 and 2 ranks (segue train --nproc, one thread each) with the time spent in\n"
     "collectives; and mujoco-testspeed on the walker's XML for reference.",
@@ -250,6 +251,21 @@ RankRates ppo_on_ranks(const std::string& recipe, const SkillRecipe& s, int rank
 
 }  // namespace
 
+// The learner's whole loop with its next rollout collected beside each update (policy_lag
+// 1): `threads` step the environments while the update runs on a thread of its own. One
+// iteration first, which starts the overlap.
+double lagged_rate(SkillRecipe s, int threads, int iterations) {
+  set_torch_threads(1);
+  s.ppo.policy_lag = s.trpo.policy_lag = 1;
+  VectorEnv envs(s.make_env, s.num_envs(), threads);
+  const std::unique_ptr<Learner> learner = make_learner(s, envs, Distributed::alone());
+  learner->iterate();
+  const int64_t n0 = physics_steps(envs);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < iterations; ++i) learner->iterate();
+  return (physics_steps(envs) - n0) / seconds_since(t0);
+}
+
 int bench_main(int argc, char** argv) {
   Args args(kBench, argc, argv);
   if (args.help()) return print_help(kBench);
@@ -272,6 +288,8 @@ int bench_main(int argc, char** argv) {
     t.learner = "trpo";
     static_cast<OnPolicyConfig&>(t.trpo) = s.ppo;
     const Rates trpo_one = rates(t, 1, iterations), trpo_all = rates(t, cores, iterations);
+    const double ppo_lag_one = lagged_rate(s, 1, iterations), ppo_lag_all = lagged_rate(s, cores, iterations);
+    const double trpo_lag_one = lagged_rate(t, 1, iterations), trpo_lag_all = lagged_rate(t, cores, iterations);
     const std::string p = robot == std::string("walker") ? "" : std::string(robot) + "_";
     for (const auto& [key, value] : std::vector<std::pair<std::string, double>>{
              {"rollout_sps", one.rollout}, {"ppo_sps", one.full}, {"bare_sps", one.bare},
@@ -280,7 +298,11 @@ int bench_main(int argc, char** argv) {
              {"bare_sps_all_cores", all.bare}, {"rollout_vs_bare_all_cores", all.rollout / all.bare},
              {"ppo_vs_bare_all_cores", all.full / all.bare}, {"trpo_sps", trpo_one.full},
              {"trpo_vs_bare", trpo_one.full / trpo_one.bare}, {"trpo_sps_all_cores", trpo_all.full},
-             {"trpo_vs_bare_all_cores", trpo_all.full / trpo_all.bare}})
+             {"trpo_vs_bare_all_cores", trpo_all.full / trpo_all.bare}, {"ppo_lag_sps", ppo_lag_one},
+             {"ppo_lag_vs_bare", ppo_lag_one / one.bare}, {"ppo_lag_sps_all_cores", ppo_lag_all},
+             {"ppo_lag_vs_bare_all_cores", ppo_lag_all / all.bare}, {"trpo_lag_sps", trpo_lag_one},
+             {"trpo_lag_vs_bare", trpo_lag_one / one.bare}, {"trpo_lag_sps_all_cores", trpo_lag_all},
+             {"trpo_lag_vs_bare_all_cores", trpo_lag_all / all.bare}})
       json.push_back({p + key, value});
     if (args.has("json")) continue;
     std::printf("%s (%s, %d envs)\n", robot, s.task.c_str(), s.ppo.num_envs);
@@ -298,6 +320,13 @@ int bench_main(int argc, char** argv) {
                 cores, all.full, all.full / all.bare, all.full / one.full);
     std::printf("  full TRPO loop, %d cores         %10.0f  %5.2f of bare, %5.2fx one thread  (target >= 0.85)\n",
                 cores, trpo_all.full, trpo_all.full / trpo_all.bare, trpo_all.full / trpo_one.full);
+    std::printf("  policy_lag 1 (the update on a thread of its own, beside the rollout):\n");
+    std::printf("    PPO loop, 1 stepping thread   %10.0f  %5.2f of bare on 1 thread\n", ppo_lag_one, ppo_lag_one / one.bare);
+    std::printf("    TRPO loop, 1 stepping thread  %10.0f  %5.2f of bare on 1 thread\n", trpo_lag_one, trpo_lag_one / one.bare);
+    std::printf("    PPO loop, %d stepping threads  %10.0f  %5.2f of bare on %d cores  (target >= 0.85)\n", cores,
+                ppo_lag_all, ppo_lag_all / all.bare, cores);
+    std::printf("    TRPO loop, %d stepping threads %10.0f  %5.2f of bare on %d cores  (target >= 0.85)\n", cores,
+                trpo_lag_all, trpo_lag_all / all.bare, cores);
   }
   // Data parallelism: the walker's PPO on 1 and 2 ranks of one thread each, with the
   // recipe's minibatches and with one minibatch per epoch (the update's exchanges and

@@ -17,13 +17,14 @@ const Command kDiagnose{
     "With TP (as segue run collects them), the share of hand-overs after which pi_b achieves its subtask: at the\n"
     "interval's start (Without TP), at its end (With TP), where q_ab switches (With TP + Q)\n"
     "and at the best of several points along pi_ab's path, in hindsight (what a better\n"
-    "switch could reach). Then the method's evaluation episodes (the recipe's eval seeds, as segue report\n"
+    "switch could reach). Each skill alone from its own start: N episodes of its own task\n"
+    "(skills.NAME.task, by default its policy file's name), push-free. Then the method's evaluation episodes (the recipe's eval seeds, as segue report\n"
     "runs them), grouped by who was in control when each ended, at which success count, and\n"
     "how (success, terminated, time limit). Uses the recipe's (by default the shipped) artefacts.",
     {"TASK"},
     {{"method", "M", "method whose episodes are grouped (default tp+q)"},
      {"recipe", "FILE", "composite recipe (default experiments/TASK.yaml)"},
-     {"starts", "N", "S_a states per transition (default 100)"},
+     {"starts", "N", "S_a states per transition, and episodes of each skill alone (default 100)"},
      {"points", "N", "hand-over points along pi_ab's path the hindsight best tries, >= 2 (default 10)"},
      {"episodes", "N", "evaluation episodes per seed (default: the recipe's eval.episodes)"},
      {"seed", "S", "seed of S_a's collection (default 0)"},
