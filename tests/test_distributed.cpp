@@ -200,11 +200,6 @@ pid_t start_two_ranks(const std::string& file, const std::string& run_dir, size_
   return reached ? launcher : -1;
 }
 
-std::string read_text(const std::string& file) {
-  std::ifstream in(file);
-  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-}
-
 // The children of a process (the launcher's ranks), in start order.
 std::vector<pid_t> children(pid_t pid) {
   std::ifstream in("/proc/" + std::to_string(pid) + "/task/" + std::to_string(pid) + "/children");
@@ -221,7 +216,7 @@ TEST_F(DataParallel, AKilledRankStopsTheOthersAndTheRerunResumesToTheUnbrokenRun
   int started = 0;
   const pid_t launcher = start_two_ranks(file, path("killed"), 3, path("killed.log"), nullptr, &started);
   ASSERT_GT(launcher, 0) << "segue train --nproc 2 ended before iteration 3, status " << started << "\n"
-                         << read_text(path("killed.log"));
+                         << read_file(path("killed.log"));
   const std::vector<pid_t> ranks = children(launcher);
   ASSERT_EQ(ranks.size(), 2u);
   ::kill(ranks[1], SIGKILL);
@@ -336,7 +331,7 @@ TEST_F(DataParallel, AHungRankStopsTheOthersWithinTheTimeout) {
     int status = 0;
     launcher = start_two_ranks(file, path("hung"), 2, log, timeout.c_str(), &status);
     if (launcher < 0) {
-      const std::string text = read_text(log);
+      const std::string text = read_file(log);
       ASSERT_NE(text.find("lost the other ranks in"), std::string::npos)
           << "segue train --nproc 2 ended before iteration 2, status " << status << "\n" << text;
     }
@@ -350,7 +345,7 @@ TEST_F(DataParallel, AHungRankStopsTheOthersWithinTheTimeout) {
   int status = 0;
   ::waitpid(launcher, &status, 0);
   EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) != 0);
-  const std::string text = read_text(log);
+  const std::string text = read_file(log);
   EXPECT_NE(text.find("error: rank 0: lost the other ranks in"), std::string::npos) << text;
   EXPECT_NE(text.find("SEGUE_DIST_TIMEOUT=" + timeout + " s"), std::string::npos) << text;
   EXPECT_NE(text.find("the other ranks were stopped"), std::string::npos) << text;

@@ -6,11 +6,11 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "core/run_dir.h"
 #include "hrl/collection.h"
 #include "hrl/composite_recipe.h"
 #include "hrl/pipeline.h"
@@ -122,8 +122,7 @@ TEST_F(TransitionTraining, PipelineWritesEveryArtefactAndResumes) {
   EXPECT_EQ(lines_of(t + "transition.csv"), 1 + 4);  // header + 2048 / (4 x 128) iterations
   EXPECT_EQ(lines_of(t + "switch.csv"), 1 + 1 + 2);
   EXPECT_FALSE(fs::exists(t + "switch_checkpoint.pt")) << "kept after q.pt was written";
-  std::ifstream json(path("run/patrol.json"));
-  std::string text((std::istreambuf_iterator<char>(json)), {});
+  const std::string text = read_file(path("run/patrol.json"));
   for (const char* m : {"\"without-tp\"", "\"tp\"", "\"tp+q\"", "\"lee\""}) EXPECT_NE(text.find(m), std::string::npos) << m;
   // A finished run skips every stage: their outputs are left as they were.
   std::vector<std::string> outputs{t + "policy.pt", t + "q.pt", t + "lee.pt", t + "actions.csv", path("run/patrol.json")};

@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "core/assets.h"
+#include "core/run_dir.h"
 #include "environments/registry.h"
 #include "hrl/composite_recipe.h"
 
@@ -61,8 +62,7 @@ namespace {
 
 // The mean success count of `method` on evaluation seed 0 in experiments/results/TASK.json.
 double table_seed0(const std::string& task, const std::string& method) {
-  std::ifstream json(std::string(SEGUE_SOURCE_DIR) + "/experiments/results/" + task + ".json");
-  std::string text((std::istreambuf_iterator<char>(json)), {});
+  const std::string text = read_file(std::string(SEGUE_SOURCE_DIR) + "/experiments/results/" + task + ".json");
   size_t at = text.find("\"" + method + "\": {");
   EXPECT_NE(at, std::string::npos) << task << " " << method;
   if (at == std::string::npos) return NAN;
