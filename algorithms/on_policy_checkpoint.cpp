@@ -108,7 +108,8 @@ void OnPolicyLearner::save(const std::string& path, const std::string& note, con
   }
   // policy_lag 1: the rollout collected beside the last update, which the next one uses.
   if (rollout_ready_)
-    for (const auto& [name, rows] : pending_rollout()) ar.write(name, torch::from_blob(rows->data(), {int64_t(rows->size())}).clone());
+    for (const auto& [name, rows] : pending_rollout())
+      ar.write(name, torch::from_blob(rows->data(), {int64_t(rows->size())}).clone());
   if (!group_.leader()) return;
   std::ostringstream bytes;
   ar.save_to(bytes);

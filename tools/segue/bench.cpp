@@ -321,8 +321,10 @@ int bench_main(int argc, char** argv) {
     std::printf("  full TRPO loop, %d cores         %10.0f  %5.2f of bare, %5.2fx one thread  (target >= 0.85)\n",
                 cores, trpo_all.full, trpo_all.full / trpo_all.bare, trpo_all.full / trpo_one.full);
     std::printf("  policy_lag 1 (the update on a thread of its own, beside the rollout):\n");
-    std::printf("    PPO loop, 1 stepping thread   %10.0f  %5.2f of bare on 1 thread\n", ppo_lag_one, ppo_lag_one / one.bare);
-    std::printf("    TRPO loop, 1 stepping thread  %10.0f  %5.2f of bare on 1 thread\n", trpo_lag_one, trpo_lag_one / one.bare);
+    std::printf("    PPO loop, 1 stepping thread   %10.0f  %5.2f of bare on 1 thread\n", ppo_lag_one,
+                ppo_lag_one / one.bare);
+    std::printf("    TRPO loop, 1 stepping thread  %10.0f  %5.2f of bare on 1 thread\n", trpo_lag_one,
+                trpo_lag_one / one.bare);
     std::printf("    PPO loop, %d stepping threads  %10.0f  %5.2f of bare on %d cores  (target >= 0.85)\n", cores,
                 ppo_lag_all, ppo_lag_all / all.bare, cores);
     std::printf("    TRPO loop, %d stepping threads %10.0f  %5.2f of bare on %d cores  (target >= 0.85)\n", cores,
