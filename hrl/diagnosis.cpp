@@ -56,14 +56,10 @@ SkillAlone skill_alone(const Skill& skill, int episodes, uint64_t seed, int thre
   SkillAlone a{skill.name, skill.task};
   if (skill.task.empty()) return a;
   // The walker's sub-tasks push the walker by default (the reference trains them so); the
-  // composite tasks never do, so the skill runs push-free where its task pushes.
-  Recipe settings = Recipe::parse("{push_prob: 0}", "push-free " + skill.task);
-  EnvFactory own = task_factory(skill.task, settings.root());
-  try {
-    settings.reject_unknown();
-  } catch (const Error&) {
-    own = reference_task_factory(skill.task);  // a task without pushes
-  }
+  // composite tasks never do, so the skill runs push-free. A task without pushes leaves
+  // the key unread and runs at its reference settings.
+  const Recipe settings = Recipe::parse("{push_prob: 0}", "push-free " + skill.task);
+  const EnvFactory own = task_factory(skill.task, settings.root());
   const EnvSpec spec = own()->spec();
   if (spec.obs_dim != skill.policy.obs_dim() || spec.act_dim != skill.policy.act_dim())
     throw Error("key 'skills." + skill.name + ".task': task '" + skill.task + "' observes " +

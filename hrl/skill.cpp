@@ -10,6 +10,8 @@ namespace segue {
 
 std::vector<Skill> read_skills(const Section& section, const EnvSpec& task) {
   std::vector<Skill> skills;
+  const std::vector<std::string> tasks = task_names();
+  auto is_task = [&](const std::string& t) { return std::find(tasks.begin(), tasks.end(), t) != tasks.end(); };
   for (const auto& name : section.keys()) {
     Section s = section.sub(name);
     Skill k;
@@ -33,8 +35,6 @@ std::vector<Skill> read_skills(const Section& section, const EnvSpec& task) {
                                   " dimensions, task '" + task.name + "' in " + std::to_string(task.act_dim));
     k.obs_begin = slice[0];
     k.obs_end = slice[1];
-    const std::vector<std::string> tasks = task_names();
-    auto is_task = [&](const std::string& t) { return std::find(tasks.begin(), tasks.end(), t) != tasks.end(); };
     const std::string stem = std::filesystem::path(file).stem().string();
     k.task = s.get<std::string>("task", is_task(stem) ? stem : "");
     if (!k.task.empty() && !is_task(k.task)) throw s.error("task", "unknown task '" + k.task + "'");
