@@ -3,8 +3,8 @@
 to assets/policies/<group>/<task>/NAME/ and records what each cost in manifest.json there
 (environment steps and wall time, read from the stage CSVs; q_ab's switch margin from
 margins.csv), and copies RUN_DIR/TASK.md/json to experiments/results/. A stage the run did
-not train (its artefact copied in from the shipped set, byte for byte) keeps the shipped
-manifest's entry.
+not train (its artefact copied in from the shipped set, byte for byte) or has not finished
+(no artefact yet: the shipped one stays) keeps the shipped manifest's entry.
 
 usage: tools/ship_transitions.py RUN_DIR [--group walker] [--no-results]
 """
@@ -49,8 +49,8 @@ for name in names:
             filecmp.cmp(os.path.join(src, f), os.path.join(dst, f), shallow=False)  # before it is copied over
         if have:
             shutil.copyfile(os.path.join(src, f), os.path.join(dst, f))
-        row = last_row(os.path.join(src, stage + ".csv"))
-        if not row and reused and stage in shipped.get(name, {}):
+        row = last_row(os.path.join(src, stage + ".csv")) if have else None
+        if not row and (reused or not have) and stage in shipped.get(name, {}):
             entry[stage] = shipped[name][stage]
         elif row:
             entry[stage] = {"env_steps": int(float(row[steps_key])) if steps_key in row and row[steps_key] else None,
