@@ -138,11 +138,17 @@ SAC::UpdateStats SAC::update(const ReplayBuffer::Batch& b) {
   q_loss.backward();
   q_opt_->step();
 
+  // The actor's loss passes through the Q networks; gradients for their weights would be
+  // cleared unused before the next Q step, so they are not computed.
+  for (auto* net : {&q1_, &q2_})
+    for (auto& w : (*net)->parameters()) w.requires_grad_(false);
   auto [act, logp] = sample(b.obs);
   auto pi_loss = (alpha * logp - torch::min(q(q1_, b.obs, act), q(q2_, b.obs, act))).mean();
   actor_opt_->zero_grad();
   pi_loss.backward();
   actor_opt_->step();
+  for (auto* net : {&q1_, &q2_})
+    for (auto& w : (*net)->parameters()) w.requires_grad_(true);
 
   if (cfg_.tune_alpha) {
     auto alpha_loss = -(log_alpha_ * (logp.detach() + target_entropy_)).mean();

@@ -3,7 +3,8 @@
 physics steps per second of bare mj_step replaying the rollouts' own trajectories, the
 rollout with policy inference, and the full PPO and TRPO loops (also with the next rollout
 collected beside each update, policy_lag 1), on one thread and on every core, for the
-walker and the arm, with the ratios to bare physics.
+walker and the arm, with the ratios to bare physics; then the time of one PPO minibatch
+step and of one TRPO update.
 
 usage: tools/bench_table.py [RUNS]
 """
@@ -47,3 +48,8 @@ for label, key, ratio in rows:
         cells.append(cell)
     print(f"| {label} | " + " | ".join(cells) + " |")
 print(f"\ncores: {int(results[0]['cores'])}")
+print("\n| the learner's update, 1 thread | " + " | ".join(f"run {i + 1}" for i in range(runs)) + " |")
+print("|---|" + "---|" * runs)
+for robot, p in (("walker", ""), ("arm", "jaco_")):
+    print(f"| {robot}: one PPO minibatch step (ms) | " + " | ".join(f"{r[p + 'ppo_minibatch_ms']:.2f}" for r in results) + " |")
+    print(f"| {robot}: one TRPO update (s) | " + " | ".join(f"{r[p + 'trpo_update_seconds']:.3f}" for r in results) + " |")

@@ -148,6 +148,7 @@ int64_t replay(const mjModel* model, int frame_skip, const std::vector<Trajector
 
 struct Rates {
   double rollout, full, bare;  // full: the learner's whole loop, rollout and update
+  double update_seconds;       // the learner's update, per iteration
 };
 
 // Every mj_step the environments ran, episode resets included.
@@ -195,9 +196,10 @@ Rates rates(const SkillRecipe& s, int threads, int iterations) {
 
   n0 = physics_steps(envs);
   t0 = std::chrono::steady_clock::now();
-  for (int i = 0; i < iterations; ++i) learner->iterate();
+  double update = 0;
+  for (int i = 0; i < iterations; ++i) update += learner->iterate().update_seconds;
   const double full = (physics_steps(envs) - n0) / seconds_since(t0);
-  return {rollout, full, bare};
+  return {rollout, full, bare, update / iterations};
 }
 
 // Full PPO on `ranks` local ranks (segue train --nproc, one thread each), read back from
@@ -291,6 +293,9 @@ int bench_main(int argc, char** argv) {
     const double ppo_lag_one = lagged_rate(s, 1, iterations), ppo_lag_all = lagged_rate(s, cores, iterations);
     const double trpo_lag_one = lagged_rate(t, 1, iterations), trpo_lag_all = lagged_rate(t, cores, iterations);
     const std::string p = robot == std::string("walker") ? "" : std::string(robot) + "_";
+    // One PPO minibatch step (forward, backward, clipping, Adam) on one thread.
+    const double minibatch_ms =
+        1e3 * one.update_seconds / (s.ppo.epochs * double(s.ppo.rollout_size()) / s.ppo.minibatch_size);
     for (const auto& [key, value] : std::vector<std::pair<std::string, double>>{
              {"rollout_sps", one.rollout}, {"ppo_sps", one.full}, {"bare_sps", one.bare},
              {"rollout_vs_bare", one.rollout / one.bare}, {"ppo_vs_bare", one.full / one.bare},
@@ -302,7 +307,8 @@ int bench_main(int argc, char** argv) {
              {"ppo_lag_vs_bare", ppo_lag_one / one.bare}, {"ppo_lag_sps_all_cores", ppo_lag_all},
              {"ppo_lag_vs_bare_all_cores", ppo_lag_all / all.bare}, {"trpo_lag_sps", trpo_lag_one},
              {"trpo_lag_vs_bare", trpo_lag_one / one.bare}, {"trpo_lag_sps_all_cores", trpo_lag_all},
-             {"trpo_lag_vs_bare_all_cores", trpo_lag_all / all.bare}})
+             {"trpo_lag_vs_bare_all_cores", trpo_lag_all / all.bare}, {"ppo_minibatch_ms", minibatch_ms},
+             {"trpo_update_seconds", trpo_one.update_seconds}})
       json.push_back({p + key, value});
     if (args.has("json")) continue;
     std::printf("%s (%s, %d envs)\n", robot, s.task.c_str(), s.ppo.num_envs);
@@ -329,6 +335,8 @@ int bench_main(int argc, char** argv) {
                 ppo_lag_all, ppo_lag_all / all.bare, cores);
     std::printf("    TRPO loop, %d stepping threads %10.0f  %5.2f of bare on %d cores  (target >= 0.85)\n", cores,
                 trpo_lag_all, trpo_lag_all / all.bare, cores);
+    std::printf("  one PPO minibatch step, 1 thread  %.2f ms; one TRPO update %.3f s\n", minibatch_ms,
+                trpo_one.update_seconds);
   }
   // Data parallelism: the walker's PPO on 1 and 2 ranks of one thread each, with the
   // recipe's minibatches and with one minibatch per epoch (the update's exchanges and
