@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <exception>
 #include <thread>
 
@@ -56,7 +57,7 @@ int64_t OnPolicyLearner::total_iterations() const {
   return (rollout_cfg_.total_steps + rollout_cfg_.rollout_size() - 1) / rollout_cfg_.rollout_size();
 }
 
-std::vector<OnPolicyLearner::Minibatch> OnPolicyLearner::shuffled_minibatches(int64_t size) const {
+std::vector<OnPolicyLearner::Minibatch> OnPolicyLearner::shuffled_minibatches(int64_t size, bool whole) const {
   const int64_t N = buf_.N, first = envs_.first_index(), M = global_rows();
   const int64_t mb = std::min<int64_t>(size, M);
   auto perm = torch::randperm(M, torch::kLong);
@@ -64,7 +65,7 @@ std::vector<OnPolicyLearner::Minibatch> OnPolicyLearner::shuffled_minibatches(in
   for (int64_t start = 0; start < M; start += mb) {
     auto idx = perm.slice(0, start, std::min(start + mb, M));
     const double rows = double(idx.numel());
-    if (!group_.single()) {
+    if (!group_.single() && !whole) {
       // Row t * global_envs + e of the whole rollout is row t * N + (e - first) here.
       auto t = idx.div(global_envs_, "floor"), e = idx.remainder(global_envs_) - first;
       idx = (t * N + e).masked_select((e >= 0) & (e < N));
@@ -72,6 +73,31 @@ std::vector<OnPolicyLearner::Minibatch> OnPolicyLearner::shuffled_minibatches(in
     out.push_back({idx, rows});
   }
   return out;
+}
+
+std::vector<float> OnPolicyLearner::gather_rollout(const std::vector<float>& data, int width) const {
+  const int64_t T = buf_.T, first = envs_.first_index();
+  // Each rank sends its first environment's index, then its rows.
+  std::string bytes(sizeof(int64_t) + data.size() * sizeof(float), '\0');
+  std::memcpy(&bytes[0], &first, sizeof(int64_t));
+  std::memcpy(&bytes[sizeof(int64_t)], data.data(), data.size() * sizeof(float));
+  std::vector<float> whole(size_t(T) * global_envs_ * width);
+  for (const std::string& part : group_.gather(bytes)) {
+    int64_t at = 0;
+    std::memcpy(&at, part.data(), sizeof(int64_t));
+    const int64_t n = int64_t((part.size() - sizeof(int64_t)) / sizeof(float)) / (T * width);  // its environments
+    const float* rows = reinterpret_cast<const float*>(part.data() + sizeof(int64_t));
+    for (int64_t t = 0; t < T; ++t)
+      std::memcpy(&whole[(size_t(t) * global_envs_ + at) * width], rows + size_t(t) * n * width,
+                  size_t(n) * width * sizeof(float));
+  }
+  return whole;
+}
+
+void OnPolicyLearner::gather_rows(const std::vector<float>& from, int width, const int64_t* rows, int n,
+                                  std::vector<float>& to) {
+  to.resize(size_t(n) * width);
+  for (int i = 0; i < n; ++i) std::copy_n(&from[size_t(rows[i]) * width], width, &to[size_t(i) * width]);
 }
 
 void OnPolicyLearner::set_log_std(double log_std) {

@@ -137,12 +137,20 @@ class OnPolicyLearner : public Learner {
  protected:
   // One permutation of the whole rollout (every rank's rows, as one process would draw
   // it) cut into minibatches of `size`: each minibatch's rows held by this rank, as local
-  // row indices, and its size over every rank.
+  // row indices, and its size over every rank. With `whole`, every row of each minibatch,
+  // indexed as in the whole rollout (gather_rollout()'s layout).
   struct Minibatch {
     torch::Tensor rows;
     double global_rows;
   };
-  std::vector<Minibatch> shuffled_minibatches(int64_t size) const;
+  std::vector<Minibatch> shuffled_minibatches(int64_t size, bool whole = false) const;
+  // Every rank's rows of `data` (`width` numbers per step, [T, N, width] on each rank), on
+  // every rank, in the whole rollout's layout [T, every rank's environments, width].
+  std::vector<float> gather_rollout(const std::vector<float>& data, int width) const;
+  // to[i] = from[rows[i]] for n rows of `width` numbers each (to is resized, which
+  // allocates only while it grows).
+  static void gather_rows(const std::vector<float>& from, int width, const int64_t* rows, int n,
+                          std::vector<float>& to);
   int64_t global_rows() const { return int64_t(buf_.T) * global_envs_; }
   void refresh_inference_copy();
 

@@ -1,7 +1,9 @@
 #include "algorithms/ppo.h"
 
+#include <algorithm>
 #include <cmath>
 
+#include "algorithms/optimizer_step.h"
 #include "algorithms/ppo_loss.h"
 #include "core/error.h"
 
@@ -26,83 +28,86 @@ PpoConfig PpoConfig::read(const Section& s, PpoConfig c) {
 
 PPO::PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed,
          const Distributed& group)
-    : OnPolicyLearner("ppo", config, net, envs, seed, group), cfg_(config) {
-  optimizer_ = std::make_unique<torch::optim::Adam>(net_->parameters(),
-                                                     torch::optim::AdamOptions(cfg_.lr).eps(1e-5));
+    : OnPolicyLearner("ppo", config, net, envs, seed, group), cfg_(config),
+      actor_(net_->actor, net.activation), critic_(net_->critic, net.activation) {
+  auto adam = std::make_unique<torch::optim::Adam>(net_->parameters(), torch::optim::AdamOptions(cfg_.lr).eps(1e-5));
+  adam_ = adam.get();
+  optimizer_ = std::move(adam);
 }
 
 double PPO::learning_rate() const {
-  return static_cast<const torch::optim::AdamOptions&>(optimizer_->param_groups().front().options()).lr();
+  return static_cast<const torch::optim::AdamOptions&>(adam_->param_groups().front().options()).lr();
 }
 
 void PPO::update(IterationStats& stats) {
-  const int64_t T = buf_.T, N = buf_.N;
   if (cfg_.anneal_lr) {
     const double span = double(total_iterations() - schedule_start_);
     double frac = span > 0 ? 1.0 - double(iteration_ - schedule_start_) / span : 0.0;
-    for (auto& group : optimizer_->param_groups())
+    for (auto& group : adam_->param_groups())
       static_cast<torch::optim::AdamOptions&>(group.options()).lr(cfg_.lr * std::max(frac, 0.0));
   }
-  auto obs = torch::from_blob(buf_.obs.data(), {T * N, buf_.in_dim});
-  auto act = torch::from_blob(buf_.actions.data(), {T * N, buf_.act_dim});
-  auto old_logp = torch::from_blob(buf_.log_probs.data(), {T * N});
-  auto adv = torch::from_blob(buf_.advantages.data(), {T * N});
-  auto ret = torch::from_blob(buf_.returns.data(), {T * N});
   const auto& spec = envs_.spec();
-  auto low = torch::tensor(spec.act_low), high = torch::tensor(spec.act_high);
+  const int k = buf_.act_dim;
+  const PpoCoefficients coefficients{cfg_.clip, cfg_.vf_coef, cfg_.ent_coef, cfg_.bound_coef};
+  const std::vector<torch::Tensor> params = net_->parameters();
+  torch::Tensor log_std = net_->log_std;
   // Every rank draws the same permutations, whatever a reward hook drew before.
   torch::manual_seed(mix_seed(seed_, 2 * iteration_ + 2) ^ 0x9e3779b9ULL);
   int batches = 0;
   double sums[4] = {0, 0, 0, 0};  // policy, value, approx_kl, clip_fraction, weighted by rows
-  std::vector<torch::Tensor> advs;  // A at this rank's rows of each minibatch of an epoch
-  std::vector<double> moments;      // each minibatch's sum and sum of squares of A, every rank's
+  std::vector<double> moments;    // each minibatch's sum and sum of squares of A, every rank's
   for (int epoch = 0; epoch < cfg_.epochs; ++epoch) {
     const std::vector<Minibatch> minibatch = shuffled_minibatches(cfg_.minibatch_size);
-    advs.clear(), moments.clear();
-    for (const Minibatch& m : minibatch) {
-      auto a = adv.index_select(0, m.rows).to(torch::kFloat64);
-      moments.push_back(a.sum().item<double>());
-      moments.push_back(a.pow(2).sum().item<double>());
-      advs.push_back(a);
+    moments.assign(2 * minibatch.size(), 0.0);
+    for (size_t j = 0; j < minibatch.size(); ++j) {
+      const int64_t* rows = minibatch[j].rows.data_ptr<int64_t>();
+      for (int64_t i = 0; i < minibatch[j].rows.numel(); ++i) {
+        const double a = buf_.advantages[rows[i]];
+        moments[2 * j] += a, moments[2 * j + 1] += a * a;
+      }
     }
     // Advantages are normalised over each whole minibatch, every rank's rows: one
     // exchange per epoch.
     group_.sum(moments.data(), moments.size());
     for (size_t j = 0; j < minibatch.size(); ++j) {
-      const torch::Tensor& idx = minibatch[j].rows;
-      const double n = minibatch[j].global_rows, mean = moments[2 * j] / n;
-      const double std = std::sqrt(std::max(moments[2 * j + 1] - n * mean * mean, 0.0) / std::max(n - 1.0, 1.0));
-      const double share = double(idx.numel()) / n;  // this rank's part of the minibatch
-      const torch::Tensor& a = advs[j];
-      optimizer_->zero_grad();
+      const int n = int(minibatch[j].rows.numel());
+      const int64_t* rows = minibatch[j].rows.data_ptr<int64_t>();
+      const double global = minibatch[j].global_rows, mean = moments[2 * j] / global;
+      const double std = std::sqrt(std::max(moments[2 * j + 1] - global * mean * mean, 0.0) / std::max(global - 1.0, 1.0));
+      const double share = double(n) / global;  // this rank's part of the minibatch
       double local = 0.0;
-      if (idx.numel() > 0) {
-        auto o = obs.index_select(0, idx);
-        auto an = ((a - mean) / (std + 1e-8)).to(torch::kFloat32);
-        auto mean_action = net_->mean(o);
-        auto logp = net_->log_prob(mean_action, act.index_select(0, idx));
-        auto value = net_->value(o);
-        PpoLoss loss = ppo_loss(logp, old_logp.index_select(0, idx), an, value, ret.index_select(0, idx),
-                                net_->entropy(), cfg_.clip, cfg_.vf_coef, cfg_.ent_coef);
-        if (cfg_.bound_coef > 0)
-          loss.total = loss.total + cfg_.bound_coef * action_bound_loss(mean_action, low, high);
-        (loss.total * share).backward();
-        local = loss.total.item<double>() * share;
-        sums[0] += loss.policy.item<double>() * share;
-        sums[1] += loss.value.item<double>() * share;
-        sums[2] += loss.approx_kl.item<double>() * share;
-        sums[3] += loss.clip_fraction.item<double>() * share;
+      if (n > 0) {
+        gather(rows, n, mean, std);
+        const auto& mu = actor_.forward(mb_.obs.data(), n);
+        const auto& value = critic_.forward(mb_.obs.data(), n);
+        dmu_.resize(n, k), dvalue_.resize(n, 1);
+        const PpoMinibatch batch{n, k, mu.data(), value.data(), mb_.actions.data(), mb_.old_log_prob.data(),
+                                 mb_.advantage.data(), mb_.returns.data(), log_std.data_ptr<float>(),
+                                 spec.act_low.data(), spec.act_high.data()};
+        if (!log_std.grad().defined()) log_std.mutable_grad() = torch::zeros_like(log_std);
+        const PpoGradient gradient{dmu_.data(), dvalue_.data(), log_std.mutable_grad().data_ptr<float>()};
+        const PpoLossTerms loss = ppo_loss(batch, coefficients, &gradient, share);
+        actor_.backward(dmu_);
+        critic_.backward(dvalue_);
+        local = loss.total * share;
+        sums[0] += loss.policy * share;
+        sums[1] += loss.value * share;
+        sums[2] += loss.approx_kl * share;
+        sums[3] += loss.clip_fraction * share;
+      } else {
+        for (const auto& p : params)
+          if (p.grad().defined()) p.mutable_grad().zero_();
       }
-      const double total = group_.sum_gradients(net_->parameters(), local);
+      const double total = group_.sum_gradients(params, local);
       if (!std::isfinite(total))
         throw Error("PPO loss became " + std::to_string(total) + " at iteration " +
                     std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
                     "'); the last checkpoint is kept: lower ppo.lr or check the task's rewards");
-      torch::nn::utils::clip_grad_norm_(net_->parameters(), cfg_.max_grad_norm);
-      optimizer_->step();
+      clip_grad_norm(params, cfg_.max_grad_norm);
+      adam_step(*adam_);
       if (cfg_.min_log_std > -20.0) {
         torch::NoGradGuard no_grad;
-        net_->log_std.clamp_min_(cfg_.min_log_std);
+        log_std.clamp_min_(cfg_.min_log_std);
       }
       ++batches;
     }
@@ -113,6 +118,16 @@ void PPO::update(IterationStats& stats) {
   stats.approx_kl = sums[2] / batches;
   stats.clip_fraction = sums[3] / batches;
   stats.entropy = net_->entropy().item<double>();
+}
+
+void PPO::gather(const int64_t* rows, int n, double adv_mean, double adv_std) {
+  gather_rows(buf_.obs, buf_.in_dim, rows, n, mb_.obs);
+  gather_rows(buf_.actions, buf_.act_dim, rows, n, mb_.actions);
+  gather_rows(buf_.log_probs, 1, rows, n, mb_.old_log_prob);
+  gather_rows(buf_.returns, 1, rows, n, mb_.returns);
+  mb_.advantage.resize(n);
+  for (int i = 0; i < n; ++i)
+    mb_.advantage[i] = float((double(buf_.advantages[rows[i]]) - adv_mean) / (adv_std + 1e-8));
 }
 
 }  // namespace segue

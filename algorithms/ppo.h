@@ -1,9 +1,13 @@
 #pragma once
 // Proximal Policy Optimization with a clipped surrogate (Schulman et al. 2017), in the
 // spirit of CleanRL's single-file PPO: iterate() (algorithms/on_policy.h) is one rollout
-// followed by update(), epochs of minibatch steps on the clipped objective.
+// followed by update(), epochs of minibatch steps on the clipped objective. Each step's
+// gradient is the objective's, written out (algorithms/ppo_loss.h) and backpropagated by
+// hand (algorithms/mlp_backprop.h): the same mathematics as autograd, without its
+// per-operator cost on networks this small.
 #include <torch/torch.h>
 
+#include "algorithms/mlp_backprop.h"
 #include "algorithms/on_policy.h"
 
 namespace segue {
@@ -32,7 +36,8 @@ class PPO : public OnPolicyLearner {
   PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed,
       const Distributed& group = Distributed::alone());
 
-  // Epochs of minibatch steps of Adam on L^CLIP + vf_coef L^VF - ent_coef H.
+  // Epochs of minibatch steps of Adam on L^CLIP + vf_coef L^VF - ent_coef S (+ bound_coef
+  // times the action-bound loss), the gradient clipped to max_grad_norm.
   void update(IterationStats& stats) override;
   std::vector<std::string> update_columns() const override {
     return {"policy_loss", "value_loss", "entropy", "approx_kl", "clip_fraction"};
@@ -43,7 +48,16 @@ class PPO : public OnPolicyLearner {
   double learning_rate() const;  // the rate the last update used
 
  private:
+  // One minibatch's rows of the rollout, copied together; advantages normalised.
+  void gather(const int64_t* rows, int n, double adv_mean, double adv_std);
+
   PpoConfig cfg_;
+  MlpBackprop actor_, critic_;
+  torch::optim::Adam* adam_ = nullptr;  // optimizer_, as what it is
+  struct {
+    std::vector<float> obs, actions, old_log_prob, advantage, returns;
+  } mb_;
+  MlpBackprop::RowMatrix dmu_, dvalue_;  // dL/dmu, dL/dV of the minibatch
 };
 
 }  // namespace segue

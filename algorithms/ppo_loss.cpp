@@ -1,38 +1,68 @@
 #include "algorithms/ppo_loss.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace segue {
 
-torch::Tensor clipped_surrogate(const torch::Tensor& logp, const torch::Tensor& old_logp,
-                                const torch::Tensor& adv, double clip) {
-  auto ratio = torch::exp(logp - old_logp);
-  auto unclipped = -adv * ratio;
-  auto clipped = -adv * torch::clamp(ratio, 1.0 - clip, 1.0 + clip);
-  return torch::max(unclipped, clipped).mean();
+double value_loss(const float* value, const float* returns, int n, float* grad, double scale) {
+  const double inv_n = 1.0 / std::max(n, 1);
+  double sum = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double error = double(value[i]) - returns[i];
+    sum += 0.5 * error * error;
+    if (grad) grad[i] = float(scale * error * inv_n);
+  }
+  return sum * inv_n;
 }
 
-torch::Tensor value_loss(const torch::Tensor& value, const torch::Tensor& returns) {
-  return 0.5 * (value - returns).pow(2).mean();
-}
-
-torch::Tensor action_bound_loss(const torch::Tensor& mean, const torch::Tensor& low,
-                                const torch::Tensor& high) {
-  auto above = torch::relu(mean - high), below = torch::relu(low - mean);
-  return (above.pow(2) + below.pow(2)).sum(-1).mean();
-}
-
-PpoLoss ppo_loss(const torch::Tensor& logp, const torch::Tensor& old_logp, const torch::Tensor& adv,
-                 const torch::Tensor& value, const torch::Tensor& returns,
-                 const torch::Tensor& entropy, double clip, double vf_coef, double ent_coef) {
-  PpoLoss l;
-  l.policy = clipped_surrogate(logp, old_logp, adv, clip);
-  l.value = value_loss(value, returns);
-  l.entropy = entropy;
-  l.total = l.policy + vf_coef * l.value - ent_coef * entropy;
-  torch::NoGradGuard no_grad;
-  auto log_ratio = logp - old_logp;
-  // k3 estimator of KL(old || new): mean((r - 1) - log r), unbiased and >= 0.
-  l.approx_kl = ((torch::exp(log_ratio) - 1) - log_ratio).mean();
-  l.clip_fraction = ((torch::exp(log_ratio) - 1).abs() > clip).to(torch::kFloat32).mean();
+PpoLossTerms ppo_loss(const PpoMinibatch& b, const PpoCoefficients& c, const PpoGradient* grad, double scale) {
+  constexpr double kHalfLog2Pi = 0.91893853320467274178;
+  const int n = b.rows, k = b.act_dim;
+  const double per_row = scale / std::max(n, 1);
+  PpoLossTerms l;
+  if (grad) std::fill(grad->log_std, grad->log_std + k, 0.0f);
+  for (int i = 0; i < n; ++i) {
+    const float* mu = b.mean + size_t(i) * k;
+    const float* a = b.actions + size_t(i) * k;
+    double log_prob = 0.0;
+    for (int j = 0; j < k; ++j) {
+      const double z = (double(a[j]) - mu[j]) * std::exp(-double(b.log_std[j]));
+      log_prob += -0.5 * z * z - b.log_std[j] - kHalfLog2Pi;
+    }
+    const double log_ratio = log_prob - b.old_log_prob[i], r = std::exp(log_ratio), adv = b.advantage[i];
+    l.policy += std::max(-adv * r, -adv * std::clamp(r, 1.0 - c.clip, 1.0 + c.clip));
+    l.approx_kl += (r - 1.0) - log_ratio;
+    l.clip_fraction += std::abs(r - 1.0) > c.clip ? 1.0 : 0.0;
+    double bound = 0.0;
+    for (int j = 0; j < k; ++j) {
+      const double above = std::max(double(mu[j]) - b.high[j], 0.0), below = std::max(b.low[j] - double(mu[j]), 0.0);
+      bound += above * above + below * below;
+    }
+    l.bound += bound;
+    if (!grad) continue;
+    // The clipped term is flat where the ratio has left the interval on the side the
+    // advantage rewards; elsewhere the max is -A r, whose derivative in log pi is -A r.
+    const bool flat = (adv > 0 && r > 1.0 + c.clip) || (adv < 0 && r < 1.0 - c.clip);
+    const double d_log_prob = flat ? 0.0 : -adv * r * per_row;
+    float* d_mu = grad->mean + size_t(i) * k;
+    for (int j = 0; j < k; ++j) {
+      const double inv_std = std::exp(-double(b.log_std[j]));
+      const double z = (double(a[j]) - mu[j]) * inv_std;
+      // d log pi / d mu_j = z_j / sigma_j; d log pi / d log sigma_j = z_j^2 - 1.
+      const double above = std::max(double(mu[j]) - b.high[j], 0.0), below = std::max(b.low[j] - double(mu[j]), 0.0);
+      d_mu[j] = float(d_log_prob * z * inv_std + c.bound_coef * 2.0 * (above - below) * per_row);
+      grad->log_std[j] += float(d_log_prob * (z * z - 1.0));
+    }
+  }
+  for (int j = 0; j < k; ++j) {
+    l.entropy += b.log_std[j] + 0.5 + kHalfLog2Pi;
+    if (grad) grad->log_std[j] += float(-c.ent_coef * scale);
+  }
+  l.value = value_loss(b.value, b.returns, n, grad ? grad->value : nullptr, scale * c.vf_coef);
+  const double inv_n = 1.0 / std::max(n, 1);
+  l.policy *= inv_n, l.bound *= inv_n, l.approx_kl *= inv_n, l.clip_fraction *= inv_n;
+  l.total = l.policy + c.vf_coef * l.value - c.ent_coef * l.entropy + c.bound_coef * l.bound;
   return l;
 }
 

@@ -1,8 +1,11 @@
 #include "algorithms/trpo.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 
 #include "algorithms/natural_gradient.h"
+#include "algorithms/optimizer_step.h"
 #include "algorithms/ppo_loss.h"
 #include "core/error.h"
 
@@ -27,9 +30,11 @@ TrpoConfig TrpoConfig::read(const Section& s) {
 
 TRPO::TRPO(const TrpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed,
            const Distributed& group)
-    : OnPolicyLearner("trpo", config, net, envs, seed, group), cfg_(config) {
+    : OnPolicyLearner("trpo", config, net, envs, seed, group), cfg_(config), critic_(net_->critic, net.activation) {
   // The optimiser fits the value network only: the policy moves by the natural step.
-  optimizer_ = std::make_unique<torch::optim::Adam>(net_->critic->parameters(), torch::optim::AdamOptions(cfg_.vf_lr));
+  auto adam = std::make_unique<torch::optim::Adam>(net_->critic->parameters(), torch::optim::AdamOptions(cfg_.vf_lr));
+  adam_ = adam.get();
+  optimizer_ = std::move(adam);
 }
 
 void TRPO::update(IterationStats& stats) {
@@ -116,31 +121,44 @@ void TRPO::policy_step(IterationStats& stats) {
 }
 
 void TRPO::fit_value(IterationStats& stats) {
-  const int64_t M = int64_t(buf_.T) * buf_.N;
-  auto obs = torch::from_blob(buf_.obs.data(), {M, buf_.in_dim});
-  auto ret = torch::from_blob(buf_.returns.data(), {M});
+  // With several ranks, rank 0 fits on the whole rollout and sends the critic to the
+  // others: the fit is hundreds of small Adam steps (the reference's minibatches of 64),
+  // and summing each step's gradient over the ranks costs far more than the step itself
+  // (docs/distributed.md). Rank 0's fit is the one a single process makes.
+  const bool alone = group_.single();
+  const std::vector<float> obs = alone ? std::vector<float>() : gather_rollout(buf_.obs, buf_.in_dim);
+  const std::vector<float> returns = alone ? std::vector<float>() : gather_rollout(buf_.returns, 1);
   const std::vector<torch::Tensor> params = net_->critic->parameters();
   double total = 0.0;
   int batches = 0;
-  for (int epoch = 0; epoch < cfg_.vf_epochs; ++epoch)
-    for (const Minibatch& m : shuffled_minibatches(cfg_.vf_minibatch)) {
-      optimizer_->zero_grad();
-      const double share = double(m.rows.numel()) / m.global_rows;  // this rank's part of the minibatch
-      double local = 0.0;
-      if (m.rows.numel() > 0) {
-        auto loss = value_loss(net_->value(obs.index_select(0, m.rows)), ret.index_select(0, m.rows)) * share;
-        loss.backward();
-        local = loss.item<double>();
+  if (group_.leader())
+    for (int epoch = 0; epoch < cfg_.vf_epochs; ++epoch)
+      for (const Minibatch& m : shuffled_minibatches(cfg_.vf_minibatch, /*whole=*/true)) {
+        const int n = int(m.rows.numel());
+        const int64_t* rows = m.rows.data_ptr<int64_t>();
+        gather_rows(alone ? buf_.obs : obs, buf_.in_dim, rows, n, vf_obs_);
+        gather_rows(alone ? buf_.returns : returns, 1, rows, n, vf_returns_);
+        const auto& value = critic_.forward(vf_obs_.data(), n);
+        dvalue_.resize(n, 1);
+        const double loss = value_loss(value.data(), vf_returns_.data(), n, dvalue_.data());
+        if (!std::isfinite(loss))
+          throw Error("TRPO's value loss became " + std::to_string(loss) + " at iteration " +
+                      std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
+                      "'); the last checkpoint is kept: lower trpo.vf_lr or check the task's rewards");
+        critic_.backward(dvalue_);
+        adam_step(*adam_);
+        total += loss, ++batches;
       }
-      const double sum = group_.sum_gradients(params, local);
-      if (!std::isfinite(sum))
-        throw Error("TRPO's value loss became " + std::to_string(sum) + " at iteration " +
-                    std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
-                    "'); the last checkpoint is kept: lower trpo.vf_lr or check the task's rewards");
-      optimizer_->step();
-      total += sum, ++batches;
-    }
-  stats.value_loss = total / batches;
+  stats.value_loss = total / std::max(batches, 1);
+  if (alone) return;
+  // Rank 0's critic and loss, on every rank.
+  torch::Tensor theta = torch::cat({flatten(params).detach(), torch::tensor({float(stats.value_loss)})});
+  std::string bytes(size_t(theta.numel()) * sizeof(float), '\0');
+  std::memcpy(&bytes[0], theta.data_ptr<float>(), bytes.size());
+  bytes = group_.broadcast(bytes);
+  std::memcpy(theta.data_ptr<float>(), bytes.data(), bytes.size());
+  assign_flat(params, theta.slice(0, 0, theta.numel() - 1));
+  stats.value_loss = theta[theta.numel() - 1].item<double>();
 }
 
 }  // namespace segue

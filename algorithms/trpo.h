@@ -11,6 +11,7 @@
 // returns, in minibatches. pi_old is the policy that collected the rollout (its
 // log-probabilities are in the buffer), so a rollout collected a policy behind is
 // accounted for.
+#include "algorithms/mlp_backprop.h"
 #include "algorithms/on_policy.h"
 
 namespace segue {
@@ -38,9 +39,10 @@ struct TrpoConfig : OnPolicyConfig {
 
 class TRPO : public OnPolicyLearner {
  public:
-  // Data-parallel with `group`: the gradient, every Fisher-vector product, the line
-  // search's surrogate and KL and the value network's gradients are summed over ranks,
-  // so every rank takes the step one process with all the environments takes.
+  // Data-parallel with `group`: the gradient, every Fisher-vector product and the line
+  // search's surrogate and KL are summed over ranks, so every rank takes the step one
+  // process with all the environments takes; rank 0 fits the value network on the whole
+  // rollout, gathered, and sends it to the others.
   TRPO(const TrpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed,
        const Distributed& group = Distributed::alone());
 
@@ -56,6 +58,11 @@ class TRPO : public OnPolicyLearner {
   void policy_step(IterationStats& stats);
   void fit_value(IterationStats& stats);
   TrpoConfig cfg_;
+  // The value fit's gradients by hand (as PPO's, algorithms/ppo.h).
+  MlpBackprop critic_;
+  torch::optim::Adam* adam_ = nullptr;  // optimizer_, as what it is
+  std::vector<float> vf_obs_, vf_returns_;
+  MlpBackprop::RowMatrix dvalue_;
 };
 
 }  // namespace segue

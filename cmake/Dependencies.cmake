@@ -6,5 +6,8 @@ find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 find_package(yaml-cpp REQUIRED)
 find_package(spdlog REQUIRED)
 find_package(GTest)
+# The BLAS LibTorch links (libblas3 or OpenBLAS, a dependency of libtorch-dev): the hand-written
+# backward passes (algorithms/mlp_backprop.cpp) call its sgemm.
+find_library(SEGUE_BLAS NAMES libblas.so.3 blas REQUIRED)
 # Torch's config appends flags we do not want to force on every target.
 set(CMAKE_CXX_FLAGS "${CMAKE_CXX_FLAGS} ${TORCH_CXX_FLAGS}")

@@ -115,9 +115,9 @@ class DataParallel : public TempDirTest {
   }
 };
 
-// TRPO on two ranks: the gradient, each Fisher-vector product, the line search's
-// surrogate and KL and the value network's minibatch gradients are summed over ranks, so
-// the two ranks take the step one process takes.
+// TRPO on two ranks: the gradient, each Fisher-vector product and the line search's
+// surrogate and KL are summed over ranks and rank 0 fits the value network on the
+// gathered rollout, so the two ranks take the step one process takes.
 // After one iteration the checkpoints agree to float tolerance; over three, the rounding
 // that conjugate gradient amplifies moves the walker's chaotic episodes apart a little,
 // so the metrics are compared to 1e-3.

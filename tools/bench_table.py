@@ -4,7 +4,8 @@ physics steps per second of bare mj_step replaying the rollouts' own trajectorie
 rollout with policy inference, and the full PPO and TRPO loops (also with the next rollout
 collected beside each update, policy_lag 1), on one thread and on every core, for the
 walker and the arm, with the ratios to bare physics; then the time of one PPO minibatch
-step and of one TRPO update.
+step and of one TRPO update; then the walker's PPO and TRPO on 1 and 2 ranks
+(docs/distributed.md).
 
 usage: tools/bench_table.py [RUNS]
 """
@@ -53,3 +54,10 @@ print("|---|" + "---|" * runs)
 for robot, p in (("walker", ""), ("arm", "jaco_")):
     print(f"| {robot}: one PPO minibatch step (ms) | " + " | ".join(f"{r[p + 'ppo_minibatch_ms']:.2f}" for r in results) + " |")
     print(f"| {robot}: one TRPO update (s) | " + " | ".join(f"{r[p + 'trpo_update_seconds']:.3f}" for r in results) + " |")
+print("\n| walker, data-parallel, physics steps/s | " + " | ".join(f"run {i + 1}: 1 rank, 2 ranks" for i in range(runs)) + " |")
+print("|---|" + "---|" * runs)
+for label, key in (("PPO, the recipe's minibatches", "ppo_sps_by_ranks"),
+                   ("PPO, one minibatch per epoch", "ppo_sps_by_ranks_one_minibatch"),
+                   ("TRPO (walker_forward_trpo.yaml)", "trpo_sps_by_ranks")):
+    cells = [f"{r[key]['1']:,.0f}, {r[key]['2']:,.0f} ({r[key]['2'] / r[key]['1']:.2f}x)" for r in results]
+    print(f"| {label} | " + " | ".join(cells) + " |")

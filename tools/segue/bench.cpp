@@ -34,11 +34,11 @@ const Command kBench{
     "the full PPO and TRPO loops (rollout and update; also with the next rollout collected\n"
     "beside each update, policy_lag 1), and the bare replay, on one thread and on every\n"
     "core, with each robot's skill recipe (walker_forward, jaco_pick); data-parallel PPO\n"
-    "on 1 and 2 ranks (segue train --nproc, one thread each) with the time spent in\n"
-    "collectives; and mujoco-testspeed on the walker's XML for reference.",
+    "and TRPO on 1 and 2 ranks (segue train --nproc, one thread each) with the time spent\n"
+    "in collectives; and mujoco-testspeed on the walker's XML for reference.",
     {},
     {{"json", "", "print one JSON object"},
-     {"iterations", "K", "PPO iterations per measurement (default 5)"},
+     {"iterations", "K", "learner iterations per measurement (default 5)"},
      {"steps", "N", "physics steps for mujoco-testspeed (default 100000)"}}};
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
@@ -202,27 +202,27 @@ Rates rates(const SkillRecipe& s, int threads, int iterations) {
   return {rollout, full, bare, update / iterations};
 }
 
-// Full PPO on `ranks` local ranks (segue train --nproc, one thread each), read back from
-// the run's metrics.csv: physics steps per second over the iterations after the first
-// (env steps x frame_skip, resets aside), and the seconds per iteration spent in
-// collectives with the other ranks.
+// The recipe's learner (PPO or TRPO) on `ranks` local ranks (segue train --nproc, one
+// thread each), read back from the run's metrics.csv: physics steps per second over the
+// iterations after the first (env steps x frame_skip, resets aside), and the seconds per
+// iteration spent in collectives with the other ranks. `sets`: further --set overrides.
 struct RankRates {
-  double ppo_sps = NAN, comm_seconds = NAN;
+  double sps = NAN, comm_seconds = NAN;
 };
 
-RankRates ppo_on_ranks(const std::string& recipe, const SkillRecipe& s, int ranks, int iterations,
-                       int64_t minibatch) {
+RankRates on_ranks(const std::string& recipe, const SkillRecipe& s, int ranks, int iterations,
+                   const std::string& sets) {
   const std::string dir = (std::filesystem::temp_directory_path() /
                            ("segue_bench_ranks_" + std::to_string(::getpid()) + "_" + std::to_string(ranks))).string();
   std::filesystem::remove_all(dir);
-  const int64_t steps = int64_t(iterations + 1) * s.ppo.rollout_size();
+  const OnPolicyConfig& config = s.learner == "trpo" ? static_cast<const OnPolicyConfig&>(s.trpo) : s.ppo;
+  const int64_t steps = int64_t(iterations + 1) * config.rollout_size();
   const std::string self = std::filesystem::read_symlink("/proc/self/exe").string();  // this segue binary
   const std::string cmd = "'" + self + "' train '" + recipe + "' --nproc " + std::to_string(ranks) +
-                          " --set run_dir=" + dir + " --set threads=1 --set eval.episodes=1 --set ppo.total_steps=" +
-                          std::to_string(steps) + " --set ppo.minibatch_size=" + std::to_string(minibatch) +
-                          " >/dev/null 2>&1";
+                          " --set run_dir=" + dir + " --set threads=1 --set eval.episodes=1 --set " + s.learner +
+                          ".total_steps=" + std::to_string(steps) + sets + " >/dev/null 2>&1";
   if (std::system(cmd.c_str()) != 0)
-    throw Error("segue bench: the " + std::to_string(ranks) + "-rank PPO run failed: " + cmd);
+    throw Error("segue bench: the " + std::to_string(ranks) + "-rank " + s.learner + " run failed: " + cmd);
   std::ifstream in(dir + "/metrics.csv");
   std::string line;
   std::getline(in, line);
@@ -247,8 +247,8 @@ RankRates ppo_on_ranks(const std::string& recipe, const SkillRecipe& s, int rank
   std::filesystem::remove_all(dir);
   auto probe = s.make_env();
   const int frame_skip = dynamic_cast<const MujocoEnv&>(*probe).frame_skip();
-  if (rows == 0) throw Error("segue bench: the " + std::to_string(ranks) + "-rank PPO run wrote no metrics");
-  return {double(rows) * s.ppo.rollout_size() * frame_skip / seconds, comm_total / rows};
+  if (rows == 0) throw Error("segue bench: the " + std::to_string(ranks) + "-rank " + s.learner + " run wrote no metrics");
+  return {double(rows) * config.rollout_size() * frame_skip / seconds, comm_total / rows};
 }
 
 }  // namespace
@@ -340,7 +340,8 @@ int bench_main(int argc, char** argv) {
   }
   // Data parallelism: the walker's PPO on 1 and 2 ranks of one thread each, with the
   // recipe's minibatches and with one minibatch per epoch (the update's exchanges and
-  // fixed per-minibatch costs then matter least).
+  // fixed per-minibatch costs then matter least); and TRPO's, with the learner
+  // comparison's recipe (the reference's settings).
   const std::string path = std::string(SEGUE_SOURCE_DIR) + "/experiments/primitives/walker_forward.yaml";
   Recipe recipe = Recipe::load(path);
   const SkillRecipe s = SkillRecipe::read(recipe, "runs/bench");
@@ -349,21 +350,34 @@ int bench_main(int argc, char** argv) {
   std::string by_ranks;
   if (!args.has("json")) std::printf("data-parallel PPO (walker_forward, segue train --nproc N, 1 thread per rank)\n");
   for (const int64_t minibatch : {int64_t(s.ppo.minibatch_size), s.ppo.rollout_size()}) {
-    const RankRates one = ppo_on_ranks(path, s, 1, iterations, minibatch);
-    const RankRates two = ppo_on_ranks(path, s, 2, iterations, minibatch);
+    const std::string sets = " --set ppo.minibatch_size=" + std::to_string(minibatch);
+    const RankRates one = on_ranks(path, s, 1, iterations, sets), two = on_ranks(path, s, 2, iterations, sets);
     const int64_t allreduces = s.ppo.epochs * ((s.ppo.rollout_size() + minibatch - 1) / minibatch);
     const std::string suffix = minibatch == s.ppo.minibatch_size ? "" : "_one_minibatch";
-    by_ranks += ", \"ppo_sps_by_ranks" + suffix + "\": " + json_object({{"1", one.ppo_sps}, {"2", two.ppo_sps}});
+    by_ranks += ", \"ppo_sps_by_ranks" + suffix + "\": " + json_object({{"1", one.sps}, {"2", two.sps}});
     json.push_back({"ppo_ranks" + suffix + "_comm_seconds_per_iteration", two.comm_seconds});
     json.push_back({"ppo_ranks" + suffix + "_allreduces_per_iteration", double(allreduces)});
     if (args.has("json")) continue;
     std::printf("  minibatches of %lld (%lld gradient all-reduces of %lld floats per iteration)\n", (long long)minibatch,
                 (long long)allreduces, (long long)floats);
-    std::printf("    1 rank                        %10.0f\n", one.ppo_sps);
-    std::printf("    2 ranks                       %10.0f  %5.2fx one rank  (target >= 1.7 on 2 cores)\n", two.ppo_sps,
-                two.ppo_sps / one.ppo_sps);
+    std::printf("    1 rank                        %10.0f\n", one.sps);
+    std::printf("    2 ranks                       %10.0f  %5.2fx one rank  (target >= 1.8 on 2 cores)\n", two.sps,
+                two.sps / one.sps);
     std::printf("    2 ranks: %.3f s per iteration in collectives, %.2f ms per all-reduce\n", two.comm_seconds,
                 1e3 * two.comm_seconds / double(allreduces));
+  }
+  const std::string trpo_path = std::string(SEGUE_SOURCE_DIR) + "/experiments/learners/walker_forward_trpo.yaml";
+  Recipe trpo_recipe = Recipe::load(trpo_path);
+  const SkillRecipe t = SkillRecipe::read(trpo_recipe, "runs/bench");
+  const RankRates trpo_one = on_ranks(trpo_path, t, 1, iterations, ""), trpo_two = on_ranks(trpo_path, t, 2, iterations, "");
+  by_ranks += ", \"trpo_sps_by_ranks\": " + json_object({{"1", trpo_one.sps}, {"2", trpo_two.sps}});
+  json.push_back({"trpo_ranks_comm_seconds_per_iteration", trpo_two.comm_seconds});
+  if (!args.has("json")) {
+    std::printf("data-parallel TRPO (walker_forward_trpo, %lld steps per iteration)\n", (long long)t.trpo.rollout_size());
+    std::printf("    1 rank                        %10.0f\n", trpo_one.sps);
+    std::printf("    2 ranks                       %10.0f  %5.2fx one rank  (target >= 1.8 on 2 cores)\n", trpo_two.sps,
+                trpo_two.sps / trpo_one.sps);
+    std::printf("    2 ranks: %.3f s per iteration in collectives\n", trpo_two.comm_seconds);
   }
   json.push_back({"ppo_ranks_gradient_floats", double(floats)});
   if (args.has("json")) {

@@ -1,0 +1,39 @@
+#pragma once
+// Backpropagation through a make_mlp network by hand: the forward pass keeps each layer's
+// output, the backward pass writes every weight's and bias's gradient into its .grad().
+// It reads and writes the LibTorch module's own tensors, so checkpoints, export and
+// autograd elsewhere (TRPO's Fisher-vector products) see one network. Why: on networks of
+// 32 or 64 units autograd's per-operator dispatch and bookkeeping cost more than the
+// arithmetic; here the matrix products go straight to BLAS and the element-wise work runs
+// in Eigen (checked equal to autograd in tests; docs/speed.md has the timings).
+#include <torch/torch.h>
+
+#include <Eigen/Dense>
+#include <vector>
+
+#include "algorithms/mlp.h"
+
+namespace segue {
+
+class MlpBackprop {
+ public:
+  using RowMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  MlpBackprop(torch::nn::Sequential net, Activation act);
+
+  // x: [batch, in] row-major, kept by pointer until backward(). Returns the output
+  // [batch, out], valid until the next forward().
+  const RowMatrix& forward(const float* x, int batch);
+  // dy: dL/d(output) [batch, out] of the last forward(); sets each parameter's .grad() to
+  // dL/d(parameter) (overwriting it, so there is nothing to zero first).
+  void backward(const RowMatrix& dy);
+
+ private:
+  std::vector<torch::nn::Linear> layers_;  // the module's own
+  Activation act_;
+  const float* x_ = nullptr;
+  int batch_ = 0;
+  std::vector<RowMatrix> out_;   // each layer's output, after its activation
+  std::vector<RowMatrix> deltas_;  // dL/d(each layer's pre-activation)
+};
+
+}  // namespace segue
