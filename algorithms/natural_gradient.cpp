@@ -1,5 +1,7 @@
 #include "algorithms/natural_gradient.h"
 
+#include <cmath>
+
 namespace segue {
 
 torch::Tensor conjugate_gradient(const std::function<torch::Tensor(const torch::Tensor&)>& matrix_vector,
@@ -21,19 +23,36 @@ torch::Tensor conjugate_gradient(const std::function<torch::Tensor(const torch::
   return x;
 }
 
-torch::Tensor gaussian_kl(const torch::Tensor& old_mean, const torch::Tensor& old_log_std, const torch::Tensor& mean,
-                          const torch::Tensor& log_std) {
-  auto old_var = torch::exp(2 * old_log_std), var = torch::exp(2 * log_std);
-  return (log_std - old_log_std + (old_var + (old_mean - mean).pow(2)) / (2 * var) - 0.5).sum(-1);
+double gaussian_kl_sum(const float* old_mean, const float* old_log_std, const float* mean, const float* log_std,
+                       int64_t rows, int act_dim) {
+  double kl = 0.0;
+  for (int j = 0; j < act_dim; ++j) {
+    const double old_var = std::exp(2.0 * old_log_std[j]), var = std::exp(2.0 * log_std[j]);
+    double squares = 0.0;
+    for (int64_t i = 0; i < rows; ++i) {
+      const double d = double(old_mean[i * act_dim + j]) - mean[i * act_dim + j];
+      squares += d * d;
+    }
+    kl += rows * (double(log_std[j]) - old_log_std[j] + old_var / (2.0 * var) - 0.5) + squares / (2.0 * var);
+  }
+  return kl;
 }
 
-torch::Tensor hessian_vector_product(const std::function<torch::Tensor()>& f, const std::vector<torch::Tensor>& params,
-                                     const torch::Tensor& v) {
-  torch::AutoGradMode enable_grad(true);  // also inside conjugate_gradient's no-grad scope
-  auto grads = torch::autograd::grad({f()}, params, {}, /*retain_graph=*/true, /*create_graph=*/true);
-  auto grad_v = (flatten(grads) * v).sum();
-  auto hv = torch::autograd::grad({grad_v}, params);
-  return flatten(hv).detach();
+GaussianFisher::GaussianFisher(MlpBackprop& mean_net, std::vector<float> log_std, double weight)
+    : net_(mean_net), log_std_(std::move(log_std)), weight_(weight) {}
+
+torch::Tensor GaussianFisher::product(const torch::Tensor& v) {
+  const int64_t p = net_.parameter_count();
+  const int k = int(log_std_.size());
+  const torch::Tensor direction = v.to(torch::kFloat32).contiguous();
+  const float* d = direction.data_ptr<float>();
+  scaled_ = net_.jvp(d);
+  for (int j = 0; j < k; ++j) scaled_.col(j) *= float(weight_ * std::exp(-2.0 * log_std_[j]));
+  torch::Tensor fv = torch::empty({p + k});
+  net_.backward(scaled_, fv.data_ptr<float>());
+  const double rows = double(scaled_.rows());
+  for (int j = 0; j < k; ++j) fv.data_ptr<float>()[p + j] = float(2.0 * weight_ * rows * d[p + j]);
+  return fv;
 }
 
 torch::Tensor flatten(const std::vector<torch::Tensor>& tensors) {

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "algorithms/actor_critic.h"
+
 namespace segue {
 
 double value_loss(const float* value, const float* returns, int n, float* grad, double scale) {
@@ -25,12 +27,7 @@ PpoLossTerms ppo_loss(const PpoMinibatch& b, const PpoCoefficients& c, const Ppo
   for (int i = 0; i < n; ++i) {
     const float* mu = b.mean + size_t(i) * k;
     const float* a = b.actions + size_t(i) * k;
-    double log_prob = 0.0;
-    for (int j = 0; j < k; ++j) {
-      const double z = (double(a[j]) - mu[j]) * std::exp(-double(b.log_std[j]));
-      log_prob += -0.5 * z * z - b.log_std[j] - kHalfLog2Pi;
-    }
-    const double log_ratio = log_prob - b.old_log_prob[i], r = std::exp(log_ratio), adv = b.advantage[i];
+    const double log_ratio = gaussian_log_prob(a, mu, b.log_std, k) - b.old_log_prob[i], r = std::exp(log_ratio), adv = b.advantage[i];
     l.policy += std::max(-adv * r, -adv * std::clamp(r, 1.0 - c.clip, 1.0 + c.clip));
     l.approx_kl += (r - 1.0) - log_ratio;
     l.clip_fraction += std::abs(r - 1.0) > c.clip ? 1.0 : 0.0;

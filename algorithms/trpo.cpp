@@ -30,7 +30,8 @@ TrpoConfig TrpoConfig::read(const Section& s) {
 
 TRPO::TRPO(const TrpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed,
            const Distributed& group)
-    : OnPolicyLearner("trpo", config, net, envs, seed, group), cfg_(config), critic_(net_->critic, net.activation) {
+    : OnPolicyLearner("trpo", config, net, envs, seed, group), cfg_(config), actor_(net_->actor, net.activation),
+      critic_(net_->critic, net.activation) {
   // The optimiser fits the value network only: the policy moves by the natural step.
   auto adam = std::make_unique<torch::optim::Adam>(net_->critic->parameters(), torch::optim::AdamOptions(cfg_.vf_lr));
   adam_ = adam.get();
@@ -45,29 +46,67 @@ void TRPO::update(IterationStats& stats) {
   stats.entropy = net_->entropy().item<double>();
 }
 
+namespace {
+
+// Each rank's part of the surrogate sum_t exp(log pi(a_t|s_t) - log pi_old(a_t|s_t)) A_t /
+// rows at the means `mu` [M, act_dim] and log standard deviations `log_std`; with
+// `d_mu`, its gradient with respect to mu (overwritten) and to log sigma (added to
+// `d_log_std`): d/d log pi = r A / rows, d log pi / d mu_j = z_j / sigma_j, d log pi / d log
+// sigma_j = z_j^2 - 1.
+double surrogate(const float* mu, const float* actions, const float* old_log_prob, const float* adv, const float* log_std,
+                 int64_t m, int k, double rows, float* d_mu = nullptr, float* d_log_std = nullptr) {
+  double sum = 0.0;
+  for (int64_t i = 0; i < m; ++i) {
+    const float* mean = mu + i * k;
+    const float* a = actions + i * k;
+    const double ra = std::exp(gaussian_log_prob(a, mean, log_std, k) - old_log_prob[i]) * adv[i];
+    sum += ra;
+    if (!d_mu) continue;
+    for (int j = 0; j < k; ++j) {
+      const double inv_std = std::exp(-double(log_std[j]));
+      const double z = (double(a[j]) - mean[j]) * inv_std;
+      d_mu[i * k + j] = float(ra / rows * z * inv_std);
+      d_log_std[j] += float(ra / rows * (z * z - 1.0));
+    }
+  }
+  return sum / rows;
+}
+
+}  // namespace
+
 void TRPO::policy_step(IterationStats& stats) {
   const int64_t T = buf_.T, N = buf_.N, M = T * N;
+  const int k = buf_.act_dim;
   const double rows = double(global_rows());  // the whole rollout's, every rank's
-  auto obs = torch::from_blob(buf_.obs.data(), {M, buf_.in_dim});
-  auto act = torch::from_blob(buf_.actions.data(), {M, buf_.act_dim});
-  auto old_logp = torch::from_blob(buf_.log_probs.data(), {M});
   // Advantages standardised over the whole rollout.
-  auto adv64 = torch::from_blob(buf_.advantages.data(), {M}).to(torch::kFloat64);
-  double moments[2] = {adv64.sum().item<double>(), adv64.pow(2).sum().item<double>()};
+  double moments[2] = {0.0, 0.0};
+  for (int64_t i = 0; i < M; ++i) moments[0] += buf_.advantages[i], moments[1] += double(buf_.advantages[i]) * buf_.advantages[i];
   group_.sum(moments, 2);
   const double mean = moments[0] / rows;
   const double std = std::sqrt(std::max(moments[1] - rows * mean * mean, 0.0) / std::max(rows - 1.0, 1.0));
-  auto adv = ((adv64 - mean) / (std + 1e-8)).to(torch::kFloat32);
+  adv_.resize(M);
+  for (int64_t i = 0; i < M; ++i) adv_[i] = float((double(buf_.advantages[i]) - mean) / (std + 1e-8));
 
   std::vector<torch::Tensor> params = net_->actor->parameters();
   params.push_back(net_->log_std);
-  // Each rank sums its rows and divides by the whole rollout's: summed over ranks, a mean.
-  auto surrogate = [&] {
-    return (torch::exp(net_->log_prob(net_->mean(obs), act) - old_logp) * adv).sum() / rows;
-  };
-  auto old_log_std = net_->log_std.detach().clone();
-  auto old_mean = net_->mean(obs).detach();
-  auto mean_kl = [&] { return gaussian_kl(old_mean, old_log_std, net_->mean(obs), net_->log_std).sum() / rows; };
+  const int64_t p = actor_.parameter_count();
+  const std::vector<float> old_log_std = to_floats(net_->log_std);
+  // The surrogate and its gradient at theta_old. Each rank sums its rows and divides by
+  // the whole rollout's: summed over ranks, a mean.
+  old_mean_ = actor_.forward(buf_.obs.data(), int(M));
+  dmu_.resize(M, k);
+  torch::Tensor g = torch::zeros({p + k});
+  double surrogate_old = surrogate(old_mean_.data(), buf_.actions.data(), buf_.log_probs.data(), adv_.data(),
+                                   old_log_std.data(), M, k, rows, dmu_.data(), g.data_ptr<float>() + p);
+  actor_.backward(dmu_, g.data_ptr<float>());
+  group_.sum(g);
+  group_.sum(&surrogate_old, 1);
+  if (!std::isfinite(surrogate_old) || !torch::isfinite(g).all().item<bool>())
+    throw Error("TRPO's surrogate became non-finite at iteration " + std::to_string(iteration_ + 1) + " (task '" +
+                envs_.spec().name + "'); the last checkpoint is kept: check the task's rewards");
+  stats.policy_loss = -surrogate_old, stats.approx_kl = 0, stats.step_size = 0;
+  if (g.abs().max().item<double>() == 0.0) return;  // all advantages zero: nothing to improve
+
   // The Fisher-vector product's rows: every fisher_stride-th row of the whole rollout
   // (row t * envs + e over every rank), so any rank layout uses the same ones.
   const int64_t envs = global_rows() / T, first = envs_.first_index(), stride = cfg_.fisher_stride;
@@ -76,26 +115,12 @@ void TRPO::policy_step(IterationStats& stats) {
     for (int64_t i = 0; i < N; ++i)
       if ((t * envs + first + i) % stride == 0) fisher_rows.push_back(t * N + i);
   const double fisher_count = double((global_rows() + stride - 1) / stride);
-  auto fisher_idx = torch::tensor(fisher_rows, torch::kLong);
-  auto fisher_obs = obs.index_select(0, fisher_idx), fisher_old_mean = old_mean.index_select(0, fisher_idx);
-  auto fisher_kl = [&] {
-    return gaussian_kl(fisher_old_mean, old_log_std, net_->mean(fisher_obs), net_->log_std).sum() / fisher_count;
-  };
-
-  auto s0 = surrogate();
-  auto g = flatten(torch::autograd::grad({s0}, params));
-  group_.sum(g);
-  double surrogate_old = s0.item<double>();
-  group_.sum(&surrogate_old, 1);
-  if (!std::isfinite(surrogate_old) || !torch::isfinite(g).all().item<bool>())
-    throw Error("TRPO's surrogate became non-finite at iteration " + std::to_string(iteration_ + 1) + " (task '" +
-                envs_.spec().name + "'); the last checkpoint is kept: check the task's rewards");
-  stats.policy_loss = -surrogate_old, stats.approx_kl = 0, stats.step_size = 0;
-  if (g.abs().max().item<double>() == 0.0) return;  // all advantages zero: nothing to improve
-
+  gather_rows(buf_.obs, buf_.in_dim, fisher_rows.data(), int(fisher_rows.size()), fisher_obs_);
+  actor_.forward(fisher_obs_.data(), int(fisher_rows.size()));
+  GaussianFisher fisher(actor_, old_log_std, 1.0 / fisher_count);
   // F v + damping v, F summed over ranks (each rank's rows weighted by the whole count).
   auto fisher_vector = [&](const torch::Tensor& v) {
-    auto fv = hessian_vector_product(fisher_kl, params, v);
+    auto fv = fisher.product(v);
     group_.sum(fv);
     return fv + cfg_.cg_damping * v;
   };
@@ -106,10 +131,13 @@ void TRPO::policy_step(IterationStats& stats) {
   auto full_step = x * std::sqrt(cfg_.max_kl / shs);
   auto theta_old = flatten(params).detach().clone();
   torch::NoGradGuard no_grad;
-  for (int k = 0; k < cfg_.line_search_steps; ++k) {
-    const double fraction = std::pow(0.5, k);
+  for (int step = 0; step < cfg_.line_search_steps; ++step) {
+    const double fraction = std::pow(0.5, step);
     assign_flat(params, theta_old + fraction * full_step);
-    double now[2] = {surrogate().item<double>(), mean_kl().item<double>()};
+    const float* log_std = net_->log_std.data_ptr<float>();
+    const auto& mu = actor_.forward(buf_.obs.data(), int(M));
+    double now[2] = {surrogate(mu.data(), buf_.actions.data(), buf_.log_probs.data(), adv_.data(), log_std, M, k, rows),
+                     gaussian_kl_sum(old_mean_.data(), old_log_std.data(), mu.data(), log_std, M, k) / rows};
     group_.sum(now, 2);
     if (std::isfinite(now[0]) && std::isfinite(now[1]) && now[1] <= 1.5 * cfg_.max_kl && now[0] > surrogate_old) {
       stats.policy_loss = -now[0], stats.approx_kl = now[1], stats.step_size = fraction;

@@ -58,8 +58,11 @@ class TRPO : public OnPolicyLearner {
   void policy_step(IterationStats& stats);
   void fit_value(IterationStats& stats);
   TrpoConfig cfg_;
-  // The value fit's gradients by hand (as PPO's, algorithms/ppo.h).
-  MlpBackprop critic_;
+  // Both networks' gradients by hand (as PPO's, algorithms/ppo.h); the Fisher-vector
+  // product by forward- and backward-mode passes (algorithms/natural_gradient.h).
+  MlpBackprop actor_, critic_;
+  std::vector<float> adv_, fisher_obs_;
+  MlpBackprop::RowMatrix old_mean_, dmu_;
   torch::optim::Adam* adam_ = nullptr;  // optimizer_, as what it is
   std::vector<float> vf_obs_, vf_returns_;
   MlpBackprop::RowMatrix dvalue_;

@@ -43,6 +43,51 @@ TEST(MlpBackprop, ForwardAndGradientsEqualAutograd) {
   }
 }
 
+TEST(MlpBackprop, DirectionalDerivativeByFiniteDifferencesAndTheFlatGradient) {
+  torch::manual_seed(8);
+  auto net = make_mlp(5, {7, 4}, 3, Activation::Tanh, 1.0);
+  auto x = torch::randn({6, 5}), dy = torch::randn({6, 3});
+  MlpBackprop backprop(net, Activation::Tanh);
+  std::vector<torch::Tensor> params = net->parameters();
+  int64_t count = 0;
+  for (const auto& p : params) count += p.numel();
+  ASSERT_EQ(backprop.parameter_count(), count);
+  auto v = torch::randn({count});
+  backprop.forward(x.data_ptr<float>(), 6);
+  const MlpBackprop::RowMatrix jv = backprop.jvp(v.data_ptr<float>());
+  // (f(theta + eps v) - f(theta - eps v)) / (2 eps), in double.
+  net->to(torch::kFloat64);
+  auto theta = torch::cat([&] {
+    std::vector<torch::Tensor> flat;
+    for (const auto& p : net->parameters()) flat.push_back(p.detach().reshape(-1).clone());
+    return flat;
+  }());
+  auto output_at = [&](const torch::Tensor& at) {
+    torch::NoGradGuard no_grad;
+    int64_t k = 0;
+    for (auto& p : net->parameters()) p.copy_(at.slice(0, k, k + p.numel()).view_as(p)), k += p.numel();
+    return net->forward(x.to(torch::kFloat64));
+  };
+  const double eps = 1e-4;
+  auto v64 = v.to(torch::kFloat64);
+  auto fd = (output_at(theta + eps * v64) - output_at(theta - eps * v64)) / (2 * eps);
+  output_at(theta);
+  net->to(torch::kFloat32);
+  auto got = torch::from_blob(const_cast<float*>(jv.data()), {6, 3}).to(torch::kFloat64);
+  EXPECT_LT(max_difference(got, fd), 1e-4 * std::max(1.0, fd.abs().max().item<double>())) << got << fd;
+  // backward(dy, flat) is backward(dy)'s gradients laid end to end (to rounding: Eigen may
+  // vectorise a sum differently into another address).
+  MlpBackprop again(net, Activation::Tanh);
+  again.forward(x.data_ptr<float>(), 6);
+  std::vector<float> flat(count);
+  const MlpBackprop::RowMatrix g = Eigen::Map<const MlpBackprop::RowMatrix>(dy.data_ptr<float>(), 6, 3);
+  again.backward(g, flat.data());
+  again.backward(g);
+  std::vector<torch::Tensor> grads;
+  for (const auto& p : net->parameters()) grads.push_back(p.grad().reshape(-1));
+  EXPECT_LT(max_difference(torch::tensor(flat), torch::cat(grads)), 1e-6);  // the same sums, rounded alike
+}
+
 TEST(OptimizerStep, ClipGradNormAsLibTorch) {
   for (double max_norm : {0.5, 100.0}) {  // scaled down, and left alone
     torch::manual_seed(1);
