@@ -50,4 +50,17 @@ inline double gaussian_log_prob(const float* a, const float* mean, const float* 
   return s;
 }
 
+// The gradient of weight x log pi(a|s) for one row: weight z_j / sigma_j for the mean
+// (written to d_mean), weight (z_j^2 - 1) for each log sigma_j (added to d_log_std),
+// z = (a - mu) / sigma. PPO's and TRPO's objectives reach the networks through it.
+inline void gaussian_log_prob_gradient(const float* a, const float* mean, const float* log_std, int n, double weight,
+                                       float* d_mean, float* d_log_std) {
+  for (int i = 0; i < n; ++i) {
+    const double inv_std = std::exp(-double(log_std[i]));
+    const double z = (double(a[i]) - mean[i]) * inv_std;
+    d_mean[i] = float(weight * z * inv_std);
+    d_log_std[i] += float(weight * (z * z - 1.0));
+  }
+}
+
 }  // namespace segue

@@ -59,6 +59,11 @@ const MlpBackprop::RowMatrix& MlpBackprop::forward(const float* x, int batch) {
   return out_.back();
 }
 
+void MlpBackprop::times_activation_slope(RowMatrix& m, const RowMatrix& h) const {
+  if (act_ == Activation::Tanh) m.array() *= 1.0f - h.array().square();
+  else m.array() *= (h.array() > 0.0f).cast<float>();
+}
+
 void MlpBackprop::backward(const RowMatrix& dy) { backprop(dy, nullptr); }
 
 void MlpBackprop::backward(const RowMatrix& dy, float* flat) { backprop(dy, flat); }
@@ -82,9 +87,7 @@ void MlpBackprop::backprop(const RowMatrix& dy, float* flat) {
     RowMatrix& below = deltas_[i - 1];
     below.resize(batch_, fan_in);
     gemm(false, false, batch_, fan_in, fan_out, delta.data(), fan_out, values_of(w), fan_in, below.data(), fan_in);
-    const RowMatrix& h = out_[i - 1];
-    if (act_ == Activation::Tanh) below.array() *= 1.0f - h.array().square();
-    else below.array() *= (h.array() > 0.0f).cast<float>();
+    times_activation_slope(below, out_[i - 1]);
   }
 }
 
@@ -103,11 +106,7 @@ const MlpBackprop::RowMatrix& MlpBackprop::jvp(const float* direction) {
     if (i > 0)
       gemm(false, true, batch_, fan_out, fan_in, tangents_[i - 1].data(), fan_in, values_of(w), fan_in, t.data(),
            fan_out, /*accumulate=*/true);
-    if (i + 1 < layers_.size()) {
-      const RowMatrix& h = out_[i];
-      if (act_ == Activation::Tanh) t.array() *= 1.0f - h.array().square();
-      else t.array() *= (h.array() > 0.0f).cast<float>();
-    }
+    if (i + 1 < layers_.size()) times_activation_slope(t, out_[i]);
   }
   return tangents_.back();
 }

@@ -38,6 +38,8 @@ class MlpBackprop {
 
  private:
   void backprop(const RowMatrix& dy, float* flat);  // flat: null for the .grad() tensors
+  // m *= act'(z) elementwise, from the activation's output h = act(z).
+  void times_activation_slope(RowMatrix& m, const RowMatrix& h) const;
   std::vector<torch::nn::Linear> layers_;  // the module's own
   Activation act_;
   const float* x_ = nullptr;

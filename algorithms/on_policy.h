@@ -157,7 +157,7 @@ class OnPolicyLearner : public Learner {
   OnPolicyConfig rollout_cfg_;
   VectorEnv& envs_;
   ActorCritic net_{nullptr};
-  std::unique_ptr<torch::optim::Optimizer> optimizer_;  // set by the learner
+  std::unique_ptr<torch::optim::Adam> optimizer_;  // set by the learner (its parameters, its rate)
   RolloutBuffer buf_;
   const Distributed& group_;
   uint64_t seed_;

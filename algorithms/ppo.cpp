@@ -30,20 +30,18 @@ PPO::PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, u
          const Distributed& group)
     : OnPolicyLearner("ppo", config, net, envs, seed, group), cfg_(config),
       actor_(net_->actor, net.activation), critic_(net_->critic, net.activation) {
-  auto adam = std::make_unique<torch::optim::Adam>(net_->parameters(), torch::optim::AdamOptions(cfg_.lr).eps(1e-5));
-  adam_ = adam.get();
-  optimizer_ = std::move(adam);
+  optimizer_ = std::make_unique<torch::optim::Adam>(net_->parameters(), torch::optim::AdamOptions(cfg_.lr).eps(1e-5));
 }
 
 double PPO::learning_rate() const {
-  return static_cast<const torch::optim::AdamOptions&>(adam_->param_groups().front().options()).lr();
+  return static_cast<const torch::optim::AdamOptions&>(optimizer_->param_groups().front().options()).lr();
 }
 
 void PPO::update(IterationStats& stats) {
   if (cfg_.anneal_lr) {
     const double span = double(total_iterations() - schedule_start_);
     double frac = span > 0 ? 1.0 - double(iteration_ - schedule_start_) / span : 0.0;
-    for (auto& group : adam_->param_groups())
+    for (auto& group : optimizer_->param_groups())
       static_cast<torch::optim::AdamOptions&>(group.options()).lr(cfg_.lr * std::max(frac, 0.0));
   }
   const auto& spec = envs_.spec();
@@ -104,7 +102,7 @@ void PPO::update(IterationStats& stats) {
                     std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
                     "'); the last checkpoint is kept: lower ppo.lr or check the task's rewards");
       clip_grad_norm(params, cfg_.max_grad_norm);
-      adam_step(*adam_);
+      adam_step(*optimizer_);
       if (cfg_.min_log_std > -20.0) {
         torch::NoGradGuard no_grad;
         log_std.clamp_min_(cfg_.min_log_std);

@@ -53,7 +53,6 @@ class PPO : public OnPolicyLearner {
 
   PpoConfig cfg_;
   MlpBackprop actor_, critic_;
-  torch::optim::Adam* adam_ = nullptr;  // optimizer_, as what it is
   struct {
     std::vector<float> obs, actions, old_log_prob, advantage, returns;
   } mb_;

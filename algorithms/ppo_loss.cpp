@@ -31,25 +31,17 @@ PpoLossTerms ppo_loss(const PpoMinibatch& b, const PpoCoefficients& c, const Ppo
     l.policy += std::max(-adv * r, -adv * std::clamp(r, 1.0 - c.clip, 1.0 + c.clip));
     l.approx_kl += (r - 1.0) - log_ratio;
     l.clip_fraction += std::abs(r - 1.0) > c.clip ? 1.0 : 0.0;
-    double bound = 0.0;
-    for (int j = 0; j < k; ++j) {
-      const double above = std::max(double(mu[j]) - b.high[j], 0.0), below = std::max(b.low[j] - double(mu[j]), 0.0);
-      bound += above * above + below * below;
+    float* d_mu = grad ? grad->mean + size_t(i) * k : nullptr;
+    if (grad) {
+      // The clipped term is flat where the ratio has left the interval on the side the
+      // advantage rewards; elsewhere the max is -A r, whose derivative in log pi is -A r.
+      const bool flat = (adv > 0 && r > 1.0 + c.clip) || (adv < 0 && r < 1.0 - c.clip);
+      gaussian_log_prob_gradient(a, mu, b.log_std, k, flat ? 0.0 : -adv * r * per_row, d_mu, grad->log_std);
     }
-    l.bound += bound;
-    if (!grad) continue;
-    // The clipped term is flat where the ratio has left the interval on the side the
-    // advantage rewards; elsewhere the max is -A r, whose derivative in log pi is -A r.
-    const bool flat = (adv > 0 && r > 1.0 + c.clip) || (adv < 0 && r < 1.0 - c.clip);
-    const double d_log_prob = flat ? 0.0 : -adv * r * per_row;
-    float* d_mu = grad->mean + size_t(i) * k;
     for (int j = 0; j < k; ++j) {
-      const double inv_std = std::exp(-double(b.log_std[j]));
-      const double z = (double(a[j]) - mu[j]) * inv_std;
-      // d log pi / d mu_j = z_j / sigma_j; d log pi / d log sigma_j = z_j^2 - 1.
       const double above = std::max(double(mu[j]) - b.high[j], 0.0), below = std::max(b.low[j] - double(mu[j]), 0.0);
-      d_mu[j] = float(d_log_prob * z * inv_std + c.bound_coef * 2.0 * (above - below) * per_row);
-      grad->log_std[j] += float(d_log_prob * (z * z - 1.0));
+      l.bound += above * above + below * below;
+      if (d_mu) d_mu[j] += float(c.bound_coef * 2.0 * (above - below) * per_row);
     }
   }
   for (int j = 0; j < k; ++j) {

@@ -33,9 +33,7 @@ TRPO::TRPO(const TrpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs
     : OnPolicyLearner("trpo", config, net, envs, seed, group), cfg_(config), actor_(net_->actor, net.activation),
       critic_(net_->critic, net.activation) {
   // The optimiser fits the value network only: the policy moves by the natural step.
-  auto adam = std::make_unique<torch::optim::Adam>(net_->critic->parameters(), torch::optim::AdamOptions(cfg_.vf_lr));
-  adam_ = adam.get();
-  optimizer_ = std::move(adam);
+  optimizer_ = std::make_unique<torch::optim::Adam>(net_->critic->parameters(), torch::optim::AdamOptions(cfg_.vf_lr));
 }
 
 void TRPO::update(IterationStats& stats) {
@@ -51,8 +49,7 @@ namespace {
 // Each rank's part of the surrogate sum_t exp(log pi(a_t|s_t) - log pi_old(a_t|s_t)) A_t /
 // rows at the means `mu` [M, act_dim] and log standard deviations `log_std`; with
 // `d_mu`, its gradient with respect to mu (overwritten) and to log sigma (added to
-// `d_log_std`): d/d log pi = r A / rows, d log pi / d mu_j = z_j / sigma_j, d log pi / d log
-// sigma_j = z_j^2 - 1.
+// `d_log_std`), d/d log pi being r A / rows.
 double surrogate(const float* mu, const float* actions, const float* old_log_prob, const float* adv, const float* log_std,
                  int64_t m, int k, double rows, float* d_mu = nullptr, float* d_log_std = nullptr) {
   double sum = 0.0;
@@ -61,13 +58,7 @@ double surrogate(const float* mu, const float* actions, const float* old_log_pro
     const float* a = actions + i * k;
     const double ra = std::exp(gaussian_log_prob(a, mean, log_std, k) - old_log_prob[i]) * adv[i];
     sum += ra;
-    if (!d_mu) continue;
-    for (int j = 0; j < k; ++j) {
-      const double inv_std = std::exp(-double(log_std[j]));
-      const double z = (double(a[j]) - mean[j]) * inv_std;
-      d_mu[i * k + j] = float(ra / rows * z * inv_std);
-      d_log_std[j] += float(ra / rows * (z * z - 1.0));
-    }
+    if (d_mu) gaussian_log_prob_gradient(a, mean, log_std, k, ra / rows, d_mu + i * k, d_log_std);
   }
   return sum / rows;
 }
@@ -154,8 +145,10 @@ void TRPO::fit_value(IterationStats& stats) {
   // and summing each step's gradient over the ranks costs far more than the step itself
   // (docs/distributed.md). Rank 0's fit is the one a single process makes.
   const bool alone = group_.single();
-  const std::vector<float> obs = alone ? std::vector<float>() : gather_rollout(buf_.obs, buf_.in_dim);
-  const std::vector<float> returns = alone ? std::vector<float>() : gather_rollout(buf_.returns, 1);
+  std::vector<float> gathered_obs, gathered_returns;
+  if (!alone) gathered_obs = gather_rollout(buf_.obs, buf_.in_dim), gathered_returns = gather_rollout(buf_.returns, 1);
+  const std::vector<float>& obs = alone ? buf_.obs : gathered_obs;
+  const std::vector<float>& returns = alone ? buf_.returns : gathered_returns;
   const std::vector<torch::Tensor> params = net_->critic->parameters();
   double total = 0.0;
   int batches = 0;
@@ -164,8 +157,8 @@ void TRPO::fit_value(IterationStats& stats) {
       for (const Minibatch& m : shuffled_minibatches(cfg_.vf_minibatch, /*whole=*/true)) {
         const int n = int(m.rows.numel());
         const int64_t* rows = m.rows.data_ptr<int64_t>();
-        gather_rows(alone ? buf_.obs : obs, buf_.in_dim, rows, n, vf_obs_);
-        gather_rows(alone ? buf_.returns : returns, 1, rows, n, vf_returns_);
+        gather_rows(obs, buf_.in_dim, rows, n, vf_obs_);
+        gather_rows(returns, 1, rows, n, vf_returns_);
         const auto& value = critic_.forward(vf_obs_.data(), n);
         dvalue_.resize(n, 1);
         const double loss = value_loss(value.data(), vf_returns_.data(), n, dvalue_.data());
@@ -174,7 +167,7 @@ void TRPO::fit_value(IterationStats& stats) {
                       std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
                       "'); the last checkpoint is kept: lower trpo.vf_lr or check the task's rewards");
         critic_.backward(dvalue_);
-        adam_step(*adam_);
+        adam_step(*optimizer_);
         total += loss, ++batches;
       }
   stats.value_loss = total / std::max(batches, 1);

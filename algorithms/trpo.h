@@ -63,7 +63,6 @@ class TRPO : public OnPolicyLearner {
   MlpBackprop actor_, critic_;
   std::vector<float> adv_, fisher_obs_;
   MlpBackprop::RowMatrix old_mean_, dmu_;
-  torch::optim::Adam* adam_ = nullptr;  // optimizer_, as what it is
   std::vector<float> vf_obs_, vf_returns_;
   MlpBackprop::RowMatrix dvalue_;
 };
