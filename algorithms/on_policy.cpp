@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "algorithms/gae.h"
+#include "algorithms/natural_gradient.h"
 #include "core/error.h"
 
 namespace segue {
@@ -57,41 +58,60 @@ int64_t OnPolicyLearner::total_iterations() const {
   return (rollout_cfg_.total_steps + rollout_cfg_.rollout_size() - 1) / rollout_cfg_.rollout_size();
 }
 
-std::vector<OnPolicyLearner::Minibatch> OnPolicyLearner::shuffled_minibatches(int64_t size, bool whole) const {
-  const int64_t N = buf_.N, first = envs_.first_index(), M = global_rows();
-  const int64_t mb = std::min<int64_t>(size, M);
+std::vector<torch::Tensor> OnPolicyLearner::shuffled_minibatches(int64_t size) const {
+  const int64_t M = global_rows(), mb = std::min<int64_t>(size, M);
   auto perm = torch::randperm(M, torch::kLong);
-  std::vector<Minibatch> out;
-  for (int64_t start = 0; start < M; start += mb) {
-    auto idx = perm.slice(0, start, std::min(start + mb, M));
-    const double rows = double(idx.numel());
-    if (!group_.single() && !whole) {
-      // Row t * global_envs + e of the whole rollout is row t * N + (e - first) here.
-      auto t = idx.div(global_envs_, "floor"), e = idx.remainder(global_envs_) - first;
-      idx = (t * N + e).masked_select((e >= 0) & (e < N));
-    }
-    out.push_back({idx, rows});
-  }
+  std::vector<torch::Tensor> out;
+  for (int64_t start = 0; start < M; start += mb) out.push_back(perm.slice(0, start, std::min(start + mb, M)));
   return out;
 }
 
-std::vector<float> OnPolicyLearner::gather_rollout(const std::vector<float>& data, int width) const {
-  const int64_t T = buf_.T, first = envs_.first_index();
-  // Each rank sends its first environment's index, then its rows.
-  std::string bytes(sizeof(int64_t) + data.size() * sizeof(float), '\0');
-  std::memcpy(&bytes[0], &first, sizeof(int64_t));
-  std::memcpy(&bytes[sizeof(int64_t)], data.data(), data.size() * sizeof(float));
-  std::vector<float> whole(size_t(T) * global_envs_ * width);
+const RolloutBuffer& OnPolicyLearner::whole_rollout() {
+  if (group_.single()) return buf_;
+  const int64_t T = buf_.T, G = global_envs_, first = envs_.first_index();
+  whole_.T = buf_.T, whole_.N = int(G), whole_.obs_dim = buf_.obs_dim, whole_.in_dim = buf_.in_dim,
+  whole_.act_dim = buf_.act_dim;
+  struct Field {
+    const std::vector<float>& mine;
+    int width;
+    std::vector<float>& whole;
+  };
+  const Field fields[] = {{buf_.obs, buf_.in_dim, whole_.obs},
+                          {buf_.actions, buf_.act_dim, whole_.actions},
+                          {buf_.log_probs, 1, whole_.log_probs},
+                          {buf_.advantages, 1, whole_.advantages},
+                          {buf_.returns, 1, whole_.returns}};
+  // One exchange: each rank sends its first environment's index, then each field's rows.
+  std::string bytes(reinterpret_cast<const char*>(&first), sizeof(int64_t));
+  int width = 0;
+  for (const Field& f : fields) {
+    bytes.append(reinterpret_cast<const char*>(f.mine.data()), f.mine.size() * sizeof(float));
+    f.whole.resize(size_t(T * G) * f.width);
+    width += f.width;
+  }
   for (const std::string& part : group_.gather(bytes)) {
     int64_t at = 0;
     std::memcpy(&at, part.data(), sizeof(int64_t));
     const int64_t n = int64_t((part.size() - sizeof(int64_t)) / sizeof(float)) / (T * width);  // its environments
-    const float* rows = reinterpret_cast<const float*>(part.data() + sizeof(int64_t));
-    for (int64_t t = 0; t < T; ++t)
-      std::memcpy(&whole[(size_t(t) * global_envs_ + at) * width], rows + size_t(t) * n * width,
-                  size_t(n) * width * sizeof(float));
+    const float* from = reinterpret_cast<const float*>(part.data() + sizeof(int64_t));
+    for (const Field& f : fields)
+      for (int64_t t = 0; t < T; ++t, from += n * f.width)
+        std::memcpy(&f.whole[size_t(t * G + at) * f.width], from, size_t(n * f.width) * sizeof(float));
   }
-  return whole;
+  return whole_;
+}
+
+void OnPolicyLearner::share_leader_update(const std::vector<torch::Tensor>& params, double* values, int n) const {
+  if (group_.single()) return;
+  torch::NoGradGuard no_grad;
+  torch::Tensor theta = flatten(params).detach();
+  std::string bytes(size_t(theta.numel()) * sizeof(float) + size_t(n) * sizeof(double), '\0');
+  std::memcpy(&bytes[0], theta.data_ptr<float>(), size_t(theta.numel()) * sizeof(float));
+  std::memcpy(&bytes[size_t(theta.numel()) * sizeof(float)], values, size_t(n) * sizeof(double));
+  bytes = group_.broadcast(bytes);
+  std::memcpy(theta.data_ptr<float>(), bytes.data(), size_t(theta.numel()) * sizeof(float));
+  std::memcpy(values, &bytes[size_t(theta.numel()) * sizeof(float)], size_t(n) * sizeof(double));
+  assign_flat(params, theta);
 }
 
 void OnPolicyLearner::gather_rows(const std::vector<float>& from, int width, const int64_t* rows, int n,

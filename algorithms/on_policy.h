@@ -55,8 +55,8 @@ class OnPolicyLearner : public Learner {
  public:
   // With `group` of several ranks, learning is data-parallel: each rank steps its share of
   // the environments (envs.first_index() says which), and every update is the one a single
-  // process with all of them makes, to float tolerance (gradients and statistics summed
-  // over ranks, normalisers merged exactly).
+  // process with all of them makes, to float tolerance (normalisers merged exactly; the
+  // update rank 0's on the gathered rollout, or its sums taken over ranks).
   OnPolicyLearner(std::string name, const OnPolicyConfig& config, const ActorCriticSpec& net, VectorEnv& envs,
                   uint64_t seed, const Distributed& group);
   const std::string& name() const override { return name_; }  // "ppo" or "trpo"
@@ -135,18 +135,18 @@ class OnPolicyLearner : public Learner {
   static Policy policy_from_checkpoint(torch::serialize::InputArchive& ar);
 
  protected:
-  // One permutation of the whole rollout (every rank's rows, as one process would draw
-  // it) cut into minibatches of `size`: each minibatch's rows held by this rank, as local
-  // row indices, and its size over every rank. With `whole`, every row of each minibatch,
-  // indexed as in the whole rollout (gather_rollout()'s layout).
-  struct Minibatch {
-    torch::Tensor rows;
-    double global_rows;
-  };
-  std::vector<Minibatch> shuffled_minibatches(int64_t size, bool whole = false) const;
-  // Every rank's rows of `data` (`width` numbers per step, [T, N, width] on each rank), on
-  // every rank, in the whole rollout's layout [T, every rank's environments, width].
-  std::vector<float> gather_rollout(const std::vector<float>& data, int width) const;
+  // One permutation of the whole rollout's rows (indices into whole_rollout()), cut into
+  // minibatches of `size`.
+  std::vector<torch::Tensor> shuffled_minibatches(int64_t size) const;
+  // With several ranks, an update is rank 0's alone, on every rank's rollout, then sent to
+  // the others: these updates are hundreds of small sequential steps, and an exchange per
+  // step costs more than the step (docs/distributed.md). Rank 0's update is then the one a
+  // single process makes. Every rank calls both, in this order.
+  // The network inputs, actions, log pi_old, advantages and returns of every rank's
+  // environments, laid out [T, every rank's environments, ...]; buf_ itself alone.
+  const RolloutBuffer& whole_rollout();
+  // Rank 0's `params` and its `n` `values` (the update's statistics), on every rank.
+  void share_leader_update(const std::vector<torch::Tensor>& params, double* values, int n) const;
   // to[i] = from[rows[i]] for n rows of `width` numbers each (to is resized, which
   // allocates only while it grows).
   static void gather_rows(const std::vector<float>& from, int width, const int64_t* rows, int n,
@@ -194,6 +194,7 @@ class OnPolicyLearner : public Learner {
   // collected rollout that no update has used yet (saved with a checkpoint).
   RolloutBuffer next_buf_;
   bool rollout_ready_ = false;
+  RolloutBuffer whole_;  // several ranks: whole_rollout()'s gathered copy
 };
 
 }  // namespace segue

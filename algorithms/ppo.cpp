@@ -49,33 +49,16 @@ void PPO::update(IterationStats& stats) {
   const PpoCoefficients coefficients{cfg_.clip, cfg_.vf_coef, cfg_.ent_coef, cfg_.bound_coef};
   const std::vector<torch::Tensor> params = net_->parameters();
   torch::Tensor log_std = net_->log_std;
-  // Every rank draws the same permutations, whatever a reward hook drew before.
+  const RolloutBuffer& rollout = whole_rollout();
+  // Every run draws the same permutations, whatever a reward hook drew before.
   torch::manual_seed(mix_seed(seed_, 2 * iteration_ + 2) ^ 0x9e3779b9ULL);
   int batches = 0;
-  double sums[4] = {0, 0, 0, 0};  // policy, value, approx_kl, clip_fraction, weighted by rows
-  std::vector<double> moments;    // each minibatch's sum and sum of squares of A, every rank's
-  for (int epoch = 0; epoch < cfg_.epochs; ++epoch) {
-    const std::vector<Minibatch> minibatch = shuffled_minibatches(cfg_.minibatch_size);
-    moments.assign(2 * minibatch.size(), 0.0);
-    for (size_t j = 0; j < minibatch.size(); ++j) {
-      const int64_t* rows = minibatch[j].rows.data_ptr<int64_t>();
-      for (int64_t i = 0; i < minibatch[j].rows.numel(); ++i) {
-        const double a = buf_.advantages[rows[i]];
-        moments[2 * j] += a, moments[2 * j + 1] += a * a;
-      }
-    }
-    // Advantages are normalised over each whole minibatch, every rank's rows: one
-    // exchange per epoch.
-    group_.sum(moments.data(), moments.size());
-    for (size_t j = 0; j < minibatch.size(); ++j) {
-      const int n = int(minibatch[j].rows.numel());
-      const int64_t* rows = minibatch[j].rows.data_ptr<int64_t>();
-      const double global = minibatch[j].global_rows, mean = moments[2 * j] / global;
-      const double std = std::sqrt(std::max(moments[2 * j + 1] - global * mean * mean, 0.0) / std::max(global - 1.0, 1.0));
-      const double share = double(n) / global;  // this rank's part of the minibatch
-      double local = 0.0;
-      if (n > 0) {
-        gather(rows, n, mean, std);
+  double sums[4] = {0, 0, 0, 0};  // policy, value, approx_kl, clip_fraction
+  if (group_.leader())
+    for (int epoch = 0; epoch < cfg_.epochs; ++epoch)
+      for (const torch::Tensor& minibatch : shuffled_minibatches(cfg_.minibatch_size)) {
+        const int n = int(minibatch.numel());
+        gather(rollout, minibatch.data_ptr<int64_t>(), n);
         const auto& mu = actor_.forward(mb_.obs.data(), n);
         const auto& value = critic_.forward(mb_.obs.data(), n);
         dmu_.resize(n, k), dvalue_.resize(n, 1);
@@ -84,48 +67,45 @@ void PPO::update(IterationStats& stats) {
                                  spec.act_low.data(), spec.act_high.data()};
         if (!log_std.grad().defined()) log_std.mutable_grad() = torch::zeros_like(log_std);
         const PpoGradient gradient{dmu_.data(), dvalue_.data(), log_std.mutable_grad().data_ptr<float>()};
-        const PpoLossTerms loss = ppo_loss(batch, coefficients, &gradient, share);
+        const PpoLossTerms loss = ppo_loss(batch, coefficients, &gradient);
+        if (!std::isfinite(loss.total))
+          throw Error("PPO loss became " + std::to_string(loss.total) + " at iteration " +
+                      std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
+                      "'); the last checkpoint is kept: lower ppo.lr or check the task's rewards");
         actor_.backward(dmu_);
         critic_.backward(dvalue_);
-        local = loss.total * share;
-        sums[0] += loss.policy * share;
-        sums[1] += loss.value * share;
-        sums[2] += loss.approx_kl * share;
-        sums[3] += loss.clip_fraction * share;
-      } else {
-        for (const auto& p : params)
-          if (p.grad().defined()) p.mutable_grad().zero_();
+        clip_grad_norm(params, cfg_.max_grad_norm);
+        adam_step(*optimizer_);
+        if (cfg_.min_log_std > -20.0) {
+          torch::NoGradGuard no_grad;
+          log_std.clamp_min_(cfg_.min_log_std);
+        }
+        sums[0] += loss.policy, sums[1] += loss.value, sums[2] += loss.approx_kl, sums[3] += loss.clip_fraction;
+        ++batches;
       }
-      const double total = group_.sum_gradients(params, local);
-      if (!std::isfinite(total))
-        throw Error("PPO loss became " + std::to_string(total) + " at iteration " +
-                    std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
-                    "'); the last checkpoint is kept: lower ppo.lr or check the task's rewards");
-      clip_grad_norm(params, cfg_.max_grad_norm);
-      adam_step(*optimizer_);
-      if (cfg_.min_log_std > -20.0) {
-        torch::NoGradGuard no_grad;
-        log_std.clamp_min_(cfg_.min_log_std);
-      }
-      ++batches;
-    }
-  }
-  group_.sum(sums, 4);
-  stats.policy_loss = sums[0] / batches;
-  stats.value_loss = sums[1] / batches;
-  stats.approx_kl = sums[2] / batches;
-  stats.clip_fraction = sums[3] / batches;
+  for (double& sum : sums) sum /= std::max(batches, 1);
+  share_leader_update(params, sums, 4);
+  stats.policy_loss = sums[0];
+  stats.value_loss = sums[1];
+  stats.approx_kl = sums[2];
+  stats.clip_fraction = sums[3];
   stats.entropy = net_->entropy().item<double>();
 }
 
-void PPO::gather(const int64_t* rows, int n, double adv_mean, double adv_std) {
-  gather_rows(buf_.obs, buf_.in_dim, rows, n, mb_.obs);
-  gather_rows(buf_.actions, buf_.act_dim, rows, n, mb_.actions);
-  gather_rows(buf_.log_probs, 1, rows, n, mb_.old_log_prob);
-  gather_rows(buf_.returns, 1, rows, n, mb_.returns);
+void PPO::gather(const RolloutBuffer& rollout, const int64_t* rows, int n) {
+  gather_rows(rollout.obs, rollout.in_dim, rows, n, mb_.obs);
+  gather_rows(rollout.actions, rollout.act_dim, rows, n, mb_.actions);
+  gather_rows(rollout.log_probs, 1, rows, n, mb_.old_log_prob);
+  gather_rows(rollout.returns, 1, rows, n, mb_.returns);
+  // Advantages normalised over the minibatch.
+  double sum = 0.0, squares = 0.0;
+  for (int i = 0; i < n; ++i) {
+    const double a = rollout.advantages[rows[i]];
+    sum += a, squares += a * a;
+  }
+  const double mean = sum / n, std = std::sqrt(std::max(squares - n * mean * mean, 0.0) / std::max(n - 1.0, 1.0));
   mb_.advantage.resize(n);
-  for (int i = 0; i < n; ++i)
-    mb_.advantage[i] = float((double(buf_.advantages[rows[i]]) - adv_mean) / (adv_std + 1e-8));
+  for (int i = 0; i < n; ++i) mb_.advantage[i] = float((double(rollout.advantages[rows[i]]) - mean) / (std + 1e-8));
 }
 
 }  // namespace segue

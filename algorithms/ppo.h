@@ -30,9 +30,8 @@ struct PpoConfig : OnPolicyConfig {
 
 class PPO : public OnPolicyLearner {
  public:
-  // Data-parallel with `group` as OnPolicyLearner says: the same minibatch rows (one
-  // permutation of the whole rollout), advantages normalised over the whole minibatch,
-  // gradients summed over ranks before the optimiser step.
+  // With `group` of several ranks, each collects its share of the rollout and rank 0
+  // updates on the whole of it (OnPolicyLearner::whole_rollout()).
   PPO(const PpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed,
       const Distributed& group = Distributed::alone());
 
@@ -49,7 +48,7 @@ class PPO : public OnPolicyLearner {
 
  private:
   // One minibatch's rows of the rollout, copied together; advantages normalised.
-  void gather(const int64_t* rows, int n, double adv_mean, double adv_std);
+  void gather(const RolloutBuffer& rollout, const int64_t* rows, int n);
 
   PpoConfig cfg_;
   MlpBackprop actor_, critic_;

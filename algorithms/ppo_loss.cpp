@@ -18,10 +18,10 @@ double value_loss(const float* value, const float* returns, int n, float* grad, 
   return sum * inv_n;
 }
 
-PpoLossTerms ppo_loss(const PpoMinibatch& b, const PpoCoefficients& c, const PpoGradient* grad, double scale) {
+PpoLossTerms ppo_loss(const PpoMinibatch& b, const PpoCoefficients& c, const PpoGradient* grad) {
   constexpr double kHalfLog2Pi = 0.91893853320467274178;
   const int n = b.rows, k = b.act_dim;
-  const double per_row = scale / std::max(n, 1);
+  const double per_row = 1.0 / std::max(n, 1);
   PpoLossTerms l;
   if (grad) std::fill(grad->log_std, grad->log_std + k, 0.0f);
   for (int i = 0; i < n; ++i) {
@@ -46,9 +46,9 @@ PpoLossTerms ppo_loss(const PpoMinibatch& b, const PpoCoefficients& c, const Ppo
   }
   for (int j = 0; j < k; ++j) {
     l.entropy += b.log_std[j] + 0.5 + kHalfLog2Pi;
-    if (grad) grad->log_std[j] += float(-c.ent_coef * scale);
+    if (grad) grad->log_std[j] += float(-c.ent_coef);
   }
-  l.value = value_loss(b.value, b.returns, n, grad ? grad->value : nullptr, scale * c.vf_coef);
+  l.value = value_loss(b.value, b.returns, n, grad ? grad->value : nullptr, c.vf_coef);
   const double inv_n = 1.0 / std::max(n, 1);
   l.policy *= inv_n, l.bound *= inv_n, l.approx_kl *= inv_n, l.clip_fraction *= inv_n;
   l.total = l.policy + c.vf_coef * l.value - c.ent_coef * l.entropy + c.bound_coef * l.bound;

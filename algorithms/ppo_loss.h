@@ -54,10 +54,7 @@ double value_loss(const float* value, const float* returns, int n, float* grad =
 //   L^CLIP = mean(max(-A r, -A clip(r, 1 - eps, 1 + eps))),  r = exp(log pi - log pi_old),
 //   L^VF   = 0.5 mean((V - R)^2),
 //   S      = sum_j (log sigma_j + 0.5 log(2 pi e))  (the Gaussian's entropy);
-// and, where `grad` is given, the gradient of scale * total written there (overwritten):
-// a rank holding part of a minibatch passes its share, so the ranks' gradients sum to the
-// whole minibatch's.
-PpoLossTerms ppo_loss(const PpoMinibatch& batch, const PpoCoefficients& c, const PpoGradient* grad = nullptr,
-                      double scale = 1.0);
+// and, where `grad` is given, the gradient of the total written there (overwritten).
+PpoLossTerms ppo_loss(const PpoMinibatch& batch, const PpoCoefficients& c, const PpoGradient* grad = nullptr);
 
 }  // namespace segue

@@ -39,10 +39,8 @@ struct TrpoConfig : OnPolicyConfig {
 
 class TRPO : public OnPolicyLearner {
  public:
-  // Data-parallel with `group`: the gradient, every Fisher-vector product and the line
-  // search's surrogate and KL are summed over ranks, so every rank takes the step one
-  // process with all the environments takes; rank 0 fits the value network on the whole
-  // rollout, gathered, and sends it to the others.
+  // With `group` of several ranks, each collects its share of the rollout and rank 0
+  // updates on the whole of it (OnPolicyLearner::whole_rollout()).
   TRPO(const TrpoConfig& config, const ActorCriticSpec& net, VectorEnv& envs, uint64_t seed,
        const Distributed& group = Distributed::alone());
 
@@ -55,8 +53,8 @@ class TRPO : public OnPolicyLearner {
   }
 
  private:
-  void policy_step(IterationStats& stats);
-  void fit_value(IterationStats& stats);
+  void policy_step(const RolloutBuffer& rollout, IterationStats& stats);
+  void fit_value(const RolloutBuffer& rollout, IterationStats& stats);
   TrpoConfig cfg_;
   // Both networks' gradients by hand (as PPO's, algorithms/ppo.h); the Fisher-vector
   // product by forward- and backward-mode passes (algorithms/natural_gradient.h).

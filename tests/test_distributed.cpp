@@ -115,12 +115,11 @@ class DataParallel : public TempDirTest {
   }
 };
 
-// TRPO on two ranks: the gradient, each Fisher-vector product and the line search's
-// surrogate and KL are summed over ranks and rank 0 fits the value network on the
-// gathered rollout, so the two ranks take the step one process takes.
-// After one iteration the checkpoints agree to float tolerance; over three, the rounding
-// that conjugate gradient amplifies moves the walker's chaotic episodes apart a little,
-// so the metrics are compared to 1e-3.
+// TRPO on two ranks: rank 0 takes the step and fits the value network on the gathered
+// rollout. After one iteration the checkpoints agree to float tolerance; over three, the
+// normalisers' moments merged over ranks round differently, conjugate gradient amplifies
+// that, and the walker's chaotic episodes drift apart a little, so the metrics are
+// compared to 1e-3.
 TEST_F(DataParallel, TwoRanksTakeTheTrpoStepOneProcessTakes) {
   for (int iterations : {1, 3}) {
     auto trpo = [&](const std::string& name) {

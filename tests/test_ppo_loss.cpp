@@ -68,13 +68,13 @@ TEST(PpoLoss, ValueLossAndTotal) {
   EXPECT_NEAR(l.total, -1.0 + 0.5 * 5.0 / 3.0 - 0.01 * l.entropy, 1e-6);
   EXPECT_NEAR(l.approx_kl, 0.0, 1e-9);
   EXPECT_NEAR(l.clip_fraction, 0.0, 1e-9);
-  // d (scale L) / d V = scale vf_coef (V - R) / n.
+  // d L / d V = vf_coef (V - R) / n.
   std::vector<float> d_mu(3), d_value(3), d_log_std(1);
   PpoGradient grad{d_mu.data(), d_value.data(), d_log_std.data()};
-  ppo_loss(rows.batch(), PpoCoefficients{0.2, 0.5, 0.01, 0.0}, &grad, 0.25);
-  EXPECT_NEAR(d_value[0], 0.25 * 0.5 * 1.0 / 3, 1e-7);
+  ppo_loss(rows.batch(), PpoCoefficients{0.2, 0.5, 0.01, 0.0}, &grad);
+  EXPECT_NEAR(d_value[0], 0.5 * 1.0 / 3, 1e-7);
   EXPECT_NEAR(d_value[1], 0.0, 1e-9);
-  EXPECT_NEAR(d_value[2], 0.25 * 0.5 * 3.0 / 3, 1e-7);
+  EXPECT_NEAR(d_value[2], 0.5 * 3.0 / 3, 1e-7);
 }
 
 TEST(PpoLoss, ActionBoundLossByHand) {
@@ -114,8 +114,7 @@ TEST(PpoLoss, GradientEqualsAutogradOfTheSameObjective) {
   const PpoMinibatch batch{n, k, f(m), f(value), f(a), f(old), f(adv), f(returns), f(ls), f(low), f(high)};
   std::vector<float> d_mu(n * k), d_value(n), d_log_std(k);
   PpoGradient grad{d_mu.data(), d_value.data(), d_log_std.data()};
-  const double scale = 0.375;
-  const PpoLossTerms l = ppo_loss(batch, c, &grad, scale);
+  const PpoLossTerms l = ppo_loss(batch, c, &grad);
 
   auto mu = m.clone().requires_grad_(), v = value.clone().requires_grad_(), s = ls.clone().requires_grad_();
   auto z = (a - mu) * torch::exp(-s);
@@ -126,7 +125,7 @@ TEST(PpoLoss, GradientEqualsAutogradOfTheSameObjective) {
   auto entropy = (s + 0.5 + kHalfLog2Pi).sum();
   auto bound = (torch::relu(mu - high).pow(2) + torch::relu(low - mu).pow(2)).sum(-1).mean();
   auto total = policy + c.vf_coef * value_term - c.ent_coef * entropy + c.bound_coef * bound;
-  (scale * total).backward();
+  total.backward();
   const double clipped = ((ratio - 1).abs() > c.clip).to(torch::kFloat64).mean().item<double>();
   ASSERT_GT(clipped, 0.1);  // the test reaches the flat parts
   EXPECT_NEAR(l.total, total.item<double>(), 1e-5);

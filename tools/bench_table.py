@@ -56,8 +56,7 @@ for robot, p in (("walker", ""), ("arm", "jaco_")):
     print(f"| {robot}: one TRPO update (s) | " + " | ".join(f"{r[p + 'trpo_update_seconds']:.3f}" for r in results) + " |")
 print("\n| walker, data-parallel, physics steps/s | " + " | ".join(f"run {i + 1}: 1 rank, 2 ranks" for i in range(runs)) + " |")
 print("|---|" + "---|" * runs)
-for label, key in (("PPO, the recipe's minibatches", "ppo_sps_by_ranks"),
-                   ("PPO, one minibatch per epoch", "ppo_sps_by_ranks_one_minibatch"),
+for label, key in (("PPO (walker_forward.yaml)", "ppo_sps_by_ranks"),
                    ("TRPO (walker_forward_trpo.yaml)", "trpo_sps_by_ranks")):
     cells = [f"{r[key]['1']:,.0f}, {r[key]['2']:,.0f} ({r[key]['2'] / r[key]['1']:.2f}x)" for r in results]
     print(f"| {label} | " + " | ".join(cells) + " |")
