@@ -56,7 +56,7 @@ class OnPolicyLearner : public Learner {
   // With `group` of several ranks, learning is data-parallel: each rank steps its share of
   // the environments (envs.first_index() says which), and every update is the one a single
   // process with all of them makes, to float tolerance (normalisers merged exactly; the
-  // update rank 0's on the gathered rollout, or its sums taken over ranks).
+  // update made by rank 0 on the gathered rollout, whole_rollout()).
   OnPolicyLearner(std::string name, const OnPolicyConfig& config, const ActorCriticSpec& net, VectorEnv& envs,
                   uint64_t seed, const Distributed& group);
   const std::string& name() const override { return name_; }  // "ppo" or "trpo"
