@@ -64,11 +64,7 @@ void MlpBackprop::times_activation_slope(RowMatrix& m, const RowMatrix& h) const
   else m.array() *= (h.array() > 0.0f).cast<float>();
 }
 
-void MlpBackprop::backward(const RowMatrix& dy) { backprop(dy, nullptr); }
-
-void MlpBackprop::backward(const RowMatrix& dy, float* flat) { backprop(dy, flat); }
-
-void MlpBackprop::backprop(const RowMatrix& dy, float* flat) {
+void MlpBackprop::backward(const RowMatrix& dy, float* flat) {
   if (dy.rows() != batch_ || dy.cols() != out_.back().cols())
     throw Error("MlpBackprop::backward: the gradient's shape is not the last forward()'s output's");
   deltas_.back() = dy;

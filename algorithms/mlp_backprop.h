@@ -24,11 +24,10 @@ class MlpBackprop {
   // [batch, out], valid until the next forward().
   const RowMatrix& forward(const float* x, int batch);
   // dy: dL/d(output) [batch, out] of the last forward(); sets each parameter's .grad() to
-  // dL/d(parameter) (overwriting it, so there is nothing to zero first).
-  void backward(const RowMatrix& dy);
-  // The same gradient written into `flat` instead, as one vector in the module's parameter
-  // order (each layer's weight, row-major, then its bias), parameter_count() long.
-  void backward(const RowMatrix& dy, float* flat);
+  // dL/d(parameter) (overwriting it, so there is nothing to zero first). With `flat`, the
+  // same gradient is written there instead, as one vector in the module's parameter order
+  // (each layer's weight, row-major, then its bias), parameter_count() long.
+  void backward(const RowMatrix& dy, float* flat = nullptr);
   // J v: the output's first-order change [batch, out] at the last forward()'s input when
   // the parameters move along `direction` (flat, in parameter order); J is d(output)/
   // d(parameters). With backward(dy, flat) (J^T dy) it gives Gauss-Newton and Fisher
@@ -37,7 +36,6 @@ class MlpBackprop {
   int64_t parameter_count() const { return offsets_.back(); }
 
  private:
-  void backprop(const RowMatrix& dy, float* flat);  // flat: null for the .grad() tensors
   // m *= act'(z) elementwise, from the activation's output h = act(z).
   void times_activation_slope(RowMatrix& m, const RowMatrix& h) const;
   std::vector<torch::nn::Linear> layers_;  // the module's own

@@ -1,5 +1,6 @@
 #include "algorithms/on_policy.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -118,6 +119,16 @@ void OnPolicyLearner::gather_rows(const std::vector<float>& from, int width, con
                                   std::vector<float>& to) {
   to.resize(size_t(n) * width);
   for (int i = 0; i < n; ++i) std::copy_n(&from[size_t(rows[i]) * width], width, &to[size_t(i) * width]);
+}
+
+void OnPolicyLearner::standardized_advantages(const std::vector<float>& advantages, const int64_t* rows, int64_t n,
+                                              std::vector<float>& out) {
+  auto at = [&](int64_t i) { return double(advantages[rows ? rows[i] : i]); };
+  double sum = 0.0, squares = 0.0;
+  for (int64_t i = 0; i < n; ++i) sum += at(i), squares += at(i) * at(i);
+  const double mean = sum / n, std = std::sqrt(std::max(squares - n * mean * mean, 0.0) / std::max(n - 1.0, 1.0));
+  out.resize(n);
+  for (int64_t i = 0; i < n; ++i) out[i] = float((at(i) - mean) / (std + 1e-8));
 }
 
 void OnPolicyLearner::set_log_std(double log_std) {

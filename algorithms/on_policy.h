@@ -151,6 +151,10 @@ class OnPolicyLearner : public Learner {
   // allocates only while it grows).
   static void gather_rows(const std::vector<float>& from, int width, const int64_t* rows, int n,
                           std::vector<float>& to);
+  // out[i] = (A[rows[i]] - mean) / (std + 1e-8) for n rows of the advantages A (rows null:
+  // the first n), mean and standard deviation taken over those rows (out is resized).
+  static void standardized_advantages(const std::vector<float>& advantages, const int64_t* rows, int64_t n,
+                                      std::vector<float>& out);
   int64_t global_rows() const { return int64_t(buf_.T) * global_envs_; }
   void refresh_inference_copy();
 

@@ -97,15 +97,7 @@ void PPO::gather(const RolloutBuffer& rollout, const int64_t* rows, int n) {
   gather_rows(rollout.actions, rollout.act_dim, rows, n, mb_.actions);
   gather_rows(rollout.log_probs, 1, rows, n, mb_.old_log_prob);
   gather_rows(rollout.returns, 1, rows, n, mb_.returns);
-  // Advantages normalised over the minibatch.
-  double sum = 0.0, squares = 0.0;
-  for (int i = 0; i < n; ++i) {
-    const double a = rollout.advantages[rows[i]];
-    sum += a, squares += a * a;
-  }
-  const double mean = sum / n, std = std::sqrt(std::max(squares - n * mean * mean, 0.0) / std::max(n - 1.0, 1.0));
-  mb_.advantage.resize(n);
-  for (int i = 0; i < n; ++i) mb_.advantage[i] = float((double(rollout.advantages[rows[i]]) - mean) / (std + 1e-8));
+  standardized_advantages(rollout.advantages, rows, n, mb_.advantage);  // over the minibatch
 }
 
 }  // namespace segue

@@ -78,12 +78,7 @@ void TRPO::policy_step(const RolloutBuffer& rollout, IterationStats& stats) {
   const float* obs = rollout.obs.data();
   const float* actions = rollout.actions.data();
   const float* old_log_prob = rollout.log_probs.data();
-  // Advantages standardised over the rollout.
-  double sum = 0.0, squares = 0.0;
-  for (int64_t i = 0; i < M; ++i) sum += rollout.advantages[i], squares += double(rollout.advantages[i]) * rollout.advantages[i];
-  const double mean = sum / M, std = std::sqrt(std::max(squares - M * mean * mean, 0.0) / std::max(M - 1.0, 1.0));
-  adv_.resize(M);
-  for (int64_t i = 0; i < M; ++i) adv_[i] = float((double(rollout.advantages[i]) - mean) / (std + 1e-8));
+  standardized_advantages(rollout.advantages, nullptr, M, adv_);  // over the rollout
 
   std::vector<torch::Tensor> params = net_->actor->parameters();
   params.push_back(net_->log_std);
