@@ -86,20 +86,22 @@ EigenMlp::EigenMlp(const std::vector<torch::Tensor>& ws, const std::vector<torch
   scratch_.resize(weights_.size());
 }
 
-void EigenMlp::forward(const float* in, int batch, float* out) const {
+void EigenMlp::forward(const float* in, int batch, float* out, Workspace* ws) const {
+  Workspace& layers = ws ? *ws : scratch_;
+  layers.resize(weights_.size());
   Eigen::Map<const RowMatrix> x(in, batch, in_dim());
   for (size_t i = 0; i < weights_.size(); ++i) {
-    RowMatrix& y = scratch_[i];
+    RowMatrix& y = layers[i];
     y.resize(batch, weights_[i].rows());  // no-op once the batch size is settled
     if (i == 0) y.noalias() = x * weights_[i].transpose();
-    else y.noalias() = scratch_[i - 1] * weights_[i].transpose();
+    else y.noalias() = layers[i - 1] * weights_[i].transpose();
     y.rowwise() += biases_[i];
     if (i + 1 < weights_.size()) {
       if (act_ == Activation::Tanh) y = y.array().tanh();
       else y = y.array().max(0.0f);
     }
   }
-  Eigen::Map<RowMatrix>(out, batch, out_dim()) = scratch_.back();
+  Eigen::Map<RowMatrix>(out, batch, out_dim()) = layers.back();
 }
 
 size_t EigenMlp::parameter_count() const {

@@ -1,8 +1,8 @@
 #pragma once
 // Multi-layer perceptrons, twice: a LibTorch module for training, and an Eigen mirror
 // for per-step inference. A 26-32-32-6 network costs ~2k multiply-adds; a LibTorch call
-// costs far more in dispatch than that, so rollouts run the Eigen copy on the whole
-// batch of environments (checked equal to LibTorch in tests).
+// costs far more in dispatch than that, so rollouts run the Eigen copy, per environment
+// on the thread stepping it (checked equal to LibTorch in tests).
 #include <torch/torch.h>
 
 #include <Eigen/Dense>
@@ -43,8 +43,11 @@ class EigenMlp {
   // From plain weight tensors W_i [out, in] and biases b_i [out].
   EigenMlp(const std::vector<torch::Tensor>& weights, const std::vector<torch::Tensor>& biases,
            Activation act);
-  // in: [batch, in_dim] row-major; out: [batch, out_dim]. Scratch is reused across calls.
-  void forward(const float* in, int batch, float* out) const;
+  // Each layer's output; kept between calls so a steady batch size allocates nothing.
+  using Workspace = std::vector<RowMatrix>;
+  // in: [batch, in_dim] row-major; out: [batch, out_dim]. `ws`: the caller's workspace,
+  // for threads running one network at once (each its own); without, the network's own.
+  void forward(const float* in, int batch, float* out, Workspace* ws = nullptr) const;
   int in_dim() const { return weights_.empty() ? 0 : static_cast<int>(weights_.front().cols()); }
   int out_dim() const { return weights_.empty() ? 0 : static_cast<int>(weights_.back().rows()); }
   Activation activation() const { return act_; }
@@ -59,7 +62,7 @@ class EigenMlp {
   std::vector<RowMatrix> weights_;  // [out, in]
   std::vector<Eigen::RowVectorXf> biases_;
   Activation act_ = Activation::Tanh;
-  mutable std::vector<RowMatrix> scratch_;
+  mutable Workspace scratch_;
 };
 
 }  // namespace segue

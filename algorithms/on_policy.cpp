@@ -49,6 +49,8 @@ OnPolicyLearner::OnPolicyLearner(std::string name, const OnPolicyConfig& config,
   if (rollout_cfg_.policy_lag > 0) next_buf_ = buf_;
   running_return_.assign(envs.size(), 0.0);
   mean_.resize(size_t(envs.size()) * net.act_dim);
+  actor_workspace_.resize(envs.size());
+  cut_.resize(size_t(rollout_cfg_.steps_per_env) * envs.size());
   env_rng_.resize(envs.size());
   return_samples_.resize(size_t(rollout_cfg_.steps_per_env) * envs.size());
   envs_.reset(mix_seed(seed, 0));
@@ -202,17 +204,14 @@ IterationStats OnPolicyLearner::iterate() {
   return stats;
 }
 
-void OnPolicyLearner::sample_actions(RolloutBuffer& buf, int t) {
+void OnPolicyLearner::sample_action(RolloutBuffer& buf, int t, int i) {
   const int N = buf.N, A = buf.act_dim;
-  float* obs = buf.obs_at(t);
-  float* act = buf.actions_at(t);
-  actor_copy_.forward(obs, N, mean_.data());
-  for (int i = 0; i < N; ++i) {
-    float* a = act + size_t(i) * A;
-    const float* mu = &mean_[size_t(i) * A];
-    for (int j = 0; j < A; ++j) a[j] = mu[j] + std::exp(log_std_[j]) * static_cast<float>(env_rng_[i].normal());
-    buf.log_probs[size_t(t) * N + i] = static_cast<float>(gaussian_log_prob(a, mu, log_std_.data(), A));
-  }
+  const size_t k = size_t(t) * N + i;
+  float* a = &buf.actions[k * A];
+  float* mu = &mean_[size_t(i) * A];
+  actor_copy_.forward(&buf.obs[k * buf.in_dim], 1, mu, &actor_workspace_[i]);
+  for (int j = 0; j < A; ++j) a[j] = mu[j] + std::exp(log_std_[j]) * static_cast<float>(env_rng_[i].normal());
+  buf.log_probs[k] = static_cast<float>(gaussian_log_prob(a, mu, log_std_.data(), A));
 }
 
 void OnPolicyLearner::collect_rollout(IterationStats& stats) {
@@ -227,29 +226,32 @@ void OnPolicyLearner::collect_steps(int64_t iteration, RolloutBuffer& buf) {
   const uint64_t noise_seed = mix_seed(seed_, 2 * iteration + 1);
   for (int i = 0; i < envs_.size(); ++i) env_rng_[i].seed(mix_seed(noise_seed, uint64_t(envs_.first_index() + i)));
   const int T = buf.T, N = buf.N, D = buf.obs_dim, I = buf.in_dim;
+  // Each environment's steps in order on one thread: the policy is fixed for the rollout,
+  // so environment i's trajectory depends only on its own state and noise stream, and the
+  // rollout is the same whatever the thread count.
+  envs_.run(T, [&](int i, int t) {
+    const size_t k = size_t(t) * N + i;
+    float* raw = &buf.raw_obs[k * D];
+    std::copy_n(envs_.obs() + size_t(i) * D, D, raw);
+    net_input(raw, &buf.obs[k * I]);
+    sample_action(buf, t, i);
+    envs_.step_one(i, &buf.actions[k * buf.act_dim]);
+    const bool terminated = envs_.terminated()[i], truncated = envs_.truncated()[i];
+    // Where the episode ended, obs() already holds the next episode's start.
+    std::copy_n((terminated || truncated ? envs_.final_obs() : envs_.obs()) + size_t(i) * D, D, &buf.next_raw_obs[k * D]);
+    buf.raw_rewards[k] = envs_.reward()[i];
+    buf.dones[k] = terminated || truncated;
+    cut_[k] = truncated && !terminated;
+  });
+  // Truncated steps in step order, with their final observation as network input.
   buf.truncated_index.clear();
   buf.truncated_obs.clear();
-  for (int t = 0; t < T; ++t) {
-    std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf.raw_obs_at(t));
-    for (int i = 0; i < N; ++i)
-      net_input(buf.raw_obs_at(t) + size_t(i) * D, buf.obs_at(t) + size_t(i) * I);
-    sample_actions(buf, t);
-    envs_.step(buf.actions_at(t));
-    std::copy(envs_.obs(), envs_.obs() + size_t(N) * D, buf.next_raw_obs_at(t));
-    for (int i = 0; i < N; ++i) {
-      size_t k = size_t(t) * N + i;
-      if (envs_.terminated()[i] || envs_.truncated()[i])  // obs() already holds the next episode's start
-        std::copy(envs_.final_obs() + size_t(i) * D, envs_.final_obs() + size_t(i + 1) * D,
-                  buf.next_raw_obs_at(t) + size_t(i) * D);
-      buf.raw_rewards[k] = envs_.reward()[i];
-      buf.dones[k] = envs_.terminated()[i] || envs_.truncated()[i];
-      if (envs_.truncated()[i] && !envs_.terminated()[i]) {
-        buf.truncated_index.push_back(static_cast<int>(k));
-        buf.truncated_obs.resize(buf.truncated_obs.size() + I);
-        net_input(envs_.final_obs() + size_t(i) * D, &buf.truncated_obs[buf.truncated_obs.size() - I]);
-      }
+  for (size_t k = 0; k < size_t(T) * N; ++k)
+    if (cut_[k]) {
+      buf.truncated_index.push_back(static_cast<int>(k));
+      buf.truncated_obs.resize(buf.truncated_obs.size() + I);
+      net_input(&buf.next_raw_obs[k * D], &buf.truncated_obs[buf.truncated_obs.size() - I]);
     }
-  }
 }
 
 void OnPolicyLearner::episode_stats(IterationStats& stats) {
@@ -377,9 +379,10 @@ void OnPolicyLearner::set_action_bias(int dim, float bias) {
 
 Policy OnPolicyLearner::policy() const {
   const auto& spec = envs_.spec();
-  return Policy(actor_copy_, std::vector<float>(obs_rms_.mean().begin(), obs_rms_.mean().end()),
-                obs_rms_.inv_std(), static_cast<float>(obs_rms_.clip()), spec.act_low, spec.act_high,
-                net_->spec.features);
+  Policy p(actor_copy_, std::vector<float>(obs_rms_.mean().begin(), obs_rms_.mean().end()), obs_rms_.inv_std(),
+           static_cast<float>(obs_rms_.clip()), spec.act_low, spec.act_high, net_->spec.features);
+  p.set_log_std(log_std_);
+  return p;
 }
 
 }  // namespace segue

@@ -180,7 +180,8 @@ class OnPolicyLearner : public Learner {
   void collect_steps(int64_t iteration, RolloutBuffer& buf);
   void finish_rollout(int64_t iteration);
   void episode_stats(IterationStats& stats);
-  void sample_actions(RolloutBuffer& buf, int t);
+  // Environment i's action at step t, from its network input, and log pi_old of it.
+  void sample_action(RolloutBuffer& buf, int t, int i);
   // The networks' input for one raw observation: normalised, then the periodic features.
   void net_input(const float* raw, float* out) const;
 
@@ -192,6 +193,8 @@ class OnPolicyLearner : public Learner {
   std::vector<float> return_samples_;  // the discounted returns of a rollout, for return_rms_
   std::vector<double> running_return_;  // discounted return per env, for reward scaling
   std::vector<float> mean_, log_std_;
+  std::vector<EigenMlp::Workspace> actor_workspace_;  // one per environment: they act on any thread
+  std::vector<uint8_t> cut_;  // per step of a rollout [T, N]: ended by a time limit, not a real end
   RewardHook reward_hook_;
   double wall_seconds_ = 0.0;
   // policy_lag 1: the rollout being collected beside an update, and whether buf_ holds a

@@ -254,9 +254,10 @@ Policy OnPolicyLearner::policy_from_checkpoint(torch::serialize::InputArchive& a
   }
   RunningMeanStd rms(spec.obs_dim);
   rms.load(ar, "obs_rms_");
-  return Policy(EigenMlp(net->actor, spec.activation),
-                std::vector<float>(rms.mean().begin(), rms.mean().end()), rms.inv_std(),
-                static_cast<float>(rms.clip()), to_floats(low), to_floats(high), spec.features);
+  Policy p(EigenMlp(net->actor, spec.activation), std::vector<float>(rms.mean().begin(), rms.mean().end()),
+           rms.inv_std(), static_cast<float>(rms.clip()), to_floats(low), to_floats(high), spec.features);
+  p.set_log_std(to_floats(net->log_std));
+  return p;
 }
 
 }  // namespace segue

@@ -3,6 +3,7 @@
 #include <torch/script.h>
 
 #include <algorithm>
+#include <cmath>
 #include <sstream>
 
 #include "algorithms/on_policy.h"
@@ -34,7 +35,14 @@ void Policy::normalize(const float* obs, int batch, float* out) const {
   }
 }
 
-void Policy::act(const float* obs, int batch, float* actions) const {
+void Policy::set_log_std(std::vector<float> log_std) {
+  if (!log_std.empty() && int(log_std.size()) != act_dim())
+    throw Error("policy: " + std::to_string(log_std.size()) + " log stds for " + std::to_string(act_dim()) + " actions");
+  log_std_ = std::move(log_std);
+}
+
+void Policy::act(const float* obs, int batch, float* actions, Rng* noise) const {
+  if (noise && log_std_.empty()) throw Error("policy: sampling asked of a policy saved without its log std");
   const int k = act_dim();
   normalized_.resize(size_t(batch) * in_dim());
   normalize(obs, batch, normalized_.data());
@@ -42,6 +50,7 @@ void Policy::act(const float* obs, int batch, float* actions) const {
   for (int b = 0; b < batch; ++b)
     for (int j = 0; j < k; ++j) {
       float& a = actions[size_t(b) * k + j];
+      if (noise) a += std::exp(log_std_[j]) * static_cast<float>(noise->normal());
       a = tanh_output_ ? act_low_[j] + 0.5f * (std::tanh(a) + 1.0f) * (act_high_[j] - act_low_[j])
                        : std::clamp(a, act_low_[j], act_high_[j]);
     }
@@ -84,6 +93,8 @@ void Policy::export_torchscript(const std::string& path) const {
   m.register_attribute("activation", c10::StringType::get(), activation_name(mlp_.activation()));
   if (!source_.empty()) m.register_attribute("source", c10::StringType::get(), source_);
   if (tanh_output_) m.register_attribute("tanh_output", c10::BoolType::get(), true);
+  if (!log_std_.empty()) m.register_buffer("log_std", vec(log_std_));  // not used by forward (the mean)
+  if (max_steps_ > 0) m.register_attribute("max_steps", c10::IntType::get(), int64_t(max_steps_));
   const size_t layers = mlp_.weights().size();
   std::ostringstream src;
   src << "def obs_dim(self) -> int:\n    return self.n_obs\n"
@@ -135,6 +146,8 @@ Policy Policy::load_torchscript(const std::string& path) {
            to_floats(m.attr("act_high").toTensor()), features);
   if (m.hasattr("source")) p.set_source(m.attr("source").toStringRef());
   if (m.hasattr("tanh_output")) p.set_tanh_output(m.attr("tanh_output").toBool());
+  if (m.hasattr("log_std")) p.set_log_std(to_floats(m.attr("log_std").toTensor()));
+  if (m.hasattr("max_steps")) p.set_max_steps(int(m.attr("max_steps").toInt()));
   // The Eigen forward must be the function the file defines: check on a random batch.
   torch::manual_seed(0);
   auto obs = torch::randn({8, p.obs_dim()}) * 3.0;

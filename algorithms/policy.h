@@ -11,6 +11,7 @@
 #include "algorithms/mlp.h"
 #include "algorithms/obs_features.h"
 #include "core/env.h"
+#include "core/rng.h"
 
 namespace segue {
 
@@ -33,8 +34,17 @@ class Policy {
   // The network's input: [clip((s - mean) * inv_std), features(s)], [batch, obs_dim] ->
   // [batch, in_dim].
   void normalize(const float* obs, int batch, float* out) const;
-  // obs: [batch, obs_dim] -> actions: [batch, act_dim]. Allocates only when the batch grows.
-  void act(const float* obs, int batch, float* actions) const;
+  // obs: [batch, obs_dim] -> actions: [batch, act_dim], the mean action. With `noise`,
+  // sampled from the Gaussian policy instead, mu + exp(log_std) * N(0, 1) before the bounds
+  // (a policy without log_std() is refused). Allocates only when the batch grows.
+  void act(const float* obs, int batch, float* actions, Rng* noise = nullptr) const;
+  // A transition policy with its own termination (Lee et al.'s): the most steps it drives
+  // before handing over, as it was trained (0: no cap).
+  int max_steps() const { return max_steps_; }
+  void set_max_steps(int steps) { max_steps_ = steps; }
+  // The Gaussian policy's log standard deviation per action (empty: saved without it).
+  const std::vector<float>& log_std() const { return log_std_; }
+  void set_log_std(std::vector<float> log_std);
 
   // Squash the network's output into the bounds, low + (tanh(x) + 1) (high - low) / 2
   // (SAC's actor), instead of clamping it (PPO's and TRPO's).
@@ -58,11 +68,12 @@ class Policy {
  private:
   static Policy load_torchscript(const std::string& path);
   EigenMlp mlp_;
-  std::vector<float> obs_mean_, obs_inv_std_, act_low_, act_high_;
+  std::vector<float> obs_mean_, obs_inv_std_, act_low_, act_high_, log_std_;
   float obs_clip_ = 10.0f;
   ObsFeatures features_;
   std::string source_;
   bool tanh_output_ = false;
+  int max_steps_ = 0;
   mutable std::vector<float> normalized_;
 };
 

@@ -22,9 +22,14 @@ struct ProximitySpec {
 class ProximityPredictorImpl : public torch::nn::Module {
  public:
   explicit ProximityPredictorImpl(const ProximitySpec& spec);
-  // Output clipped to [0, 1].
-  torch::Tensor forward(const torch::Tensor& obs) { return net->forward(obs).squeeze(-1).clamp(0.0, 1.0); }
-  torch::Tensor loss(const torch::Tensor& obs, const torch::Tensor& label) { return (forward(obs) - label).pow(2).mean(); }
+  // P(s): the network's output clipped to [0, 1].
+  torch::Tensor forward(const torch::Tensor& obs) { return unclipped(obs).clamp(0.0, 1.0); }
+  // Least squares on the unclipped output: a state predicted beyond [0, 1] on the wrong
+  // side of its label still gets a gradient (clipped, it would get none).
+  torch::Tensor loss(const torch::Tensor& obs, const torch::Tensor& label) {
+    return (unclipped(obs) - label).pow(2).mean();
+  }
+  torch::Tensor unclipped(const torch::Tensor& obs) { return net->forward(obs).squeeze(-1); }
   ProximitySpec spec;
   torch::nn::Sequential net{nullptr};
 };

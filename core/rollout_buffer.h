@@ -39,10 +39,6 @@ struct RolloutBuffer {
     truncated_index.reserve(steps);
     truncated_obs.reserve(steps * id);
   }
-  float* obs_at(int t) { return &obs[size_t(t) * N * in_dim]; }
-  float* raw_obs_at(int t) { return &raw_obs[size_t(t) * N * obs_dim]; }
-  float* next_raw_obs_at(int t) { return &next_raw_obs[size_t(t) * N * obs_dim]; }
-  float* actions_at(int t) { return &actions[size_t(t) * N * act_dim]; }
 };
 
 }  // namespace segue

@@ -22,27 +22,30 @@ VectorEnv::VectorEnv(const Factory& make, int num_envs, int threads, int first_i
   info_.resize(num_envs);
   running_.resize(num_envs);
   finished_.reserve(num_envs);
+  ended_.resize(num_envs);
   // Built once: std::function construction per step would allocate.
   step_block_ = [this](int begin, int end) {
-    for (int i = begin; i < end; ++i) {
-      float* o = &obs_[size_t(i) * obs_dim_];
-      StepResult r = envs_[i]->step(actions_ + size_t(i) * act_dim_, o);
-      reward_[i] = r.reward;
-      terminated_[i] = r.terminated;
-      truncated_[i] = r.truncated;
-      info_[i] = r.info;
-      EpisodeStats& ep = running_[i];
-      ep.ret += r.reward;
-      ep.length += 1;
-      for (int k = 0; k < kMaxMetrics; ++k) ep.metric_sums[k] += r.info.metrics[k];
-      if (r.done()) {
-        ep.success = r.info.success;
-        ep.success_count = r.info.success_count;
-        std::copy(o, o + obs_dim_, &final_obs_[size_t(i) * obs_dim_]);
-        envs_[i]->reset(o);
-      }
-    }
+    for (int i = begin; i < end; ++i) step_one(i, actions_ + size_t(i) * act_dim_);
   };
+}
+
+void VectorEnv::step_one(int i, const float* action) {
+  float* o = &obs_[size_t(i) * obs_dim_];
+  StepResult r = envs_[i]->step(action, o);
+  reward_[i] = r.reward;
+  terminated_[i] = r.terminated;
+  truncated_[i] = r.truncated;
+  info_[i] = r.info;
+  EpisodeStats& ep = running_[i];
+  ep.ret += r.reward;
+  ep.length += 1;
+  for (int k = 0; k < kMaxMetrics; ++k) ep.metric_sums[k] += r.info.metrics[k];
+  if (r.done()) {
+    ep.success = r.info.success;
+    ep.success_count = r.info.success_count;
+    std::copy(o, o + obs_dim_, &final_obs_[size_t(i) * obs_dim_]);
+    envs_[i]->reset(o);
+  }
 }
 
 // Per environment: the snapshot's length, the snapshot, then the episode's running totals.
@@ -122,6 +125,26 @@ void VectorEnv::step(const float* actions) {
       running_[i] = EpisodeStats{};
     }
   }
+}
+
+void VectorEnv::run(int steps, const std::function<void(int, int)>& body) {
+  pool_.parallel_for(size(), [&](int begin, int end) {
+    for (int i = begin; i < end; ++i) {
+      ended_[i].clear();
+      for (int t = 0; t < steps; ++t) {
+        body(i, t);
+        if (terminated_[i] || truncated_[i]) {
+          ended_[i].emplace_back(t, running_[i]);
+          running_[i] = EpisodeStats{};
+        }
+      }
+    }
+  });
+  // Step order: by step, then by environment, as step() appends them.
+  std::vector<size_t> next(size(), 0);  // (allocates a few bytes per rollout, not per step)
+  for (int t = 0; t < steps; ++t)
+    for (int i = 0; i < size(); ++i)
+      if (next[i] < ended_[i].size() && ended_[i][next[i]].first == t) finished_.push_back(ended_[i][next[i]++].second);
 }
 
 }  // namespace segue

@@ -1,11 +1,14 @@
 #pragma once
-// N environments stepped together on a thread pool. Buffers are laid out row-major
-// ([N, obs_dim]) so a policy can run once on the whole batch. An environment that
+// N environments stepped on a thread pool: together, one step at a time (step(), for a
+// policy run once on the whole batch), or each through a whole rollout on one thread
+// (run(), for a policy fixed for the rollout). Buffers are laid out row-major
+// ([N, obs_dim]). An environment that
 // finishes an episode is reset at once; the observation it ended on is kept in
 // final_obs() (a truncated episode is bootstrapped from it) and the episode's totals
 // are queued for the caller.
 #include <functional>
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include "core/env.h"
@@ -37,6 +40,15 @@ class VectorEnv {
   // Applies actions [N, act_dim]; afterwards obs(), reward(), terminated(), truncated()
   // describe the step and finished episodes are appended to finished().
   void step(const float* actions);
+  // Steps every environment `steps` times with actions chosen one environment at a time,
+  // for a collector whose policy is fixed for the whole call: body(i, t) decides
+  // environment i's t-th action from obs() row i and calls step_one(i, action) once. Each
+  // environment runs all its steps on one thread, the environments spread over the pool:
+  // one hand-off per call instead of one per step, and the policy's work runs in parallel
+  // too. finished() then holds the episodes in the order `steps` calls of step() give.
+  void run(int steps, const std::function<void(int, int)>& body);
+  // Environment i's step inside run(); afterwards row i of obs(), reward() ... describes it.
+  void step_one(int i, const float* action);
 
   const float* obs() const { return obs_.data(); }
   const float* final_obs() const { return final_obs_.data(); }
@@ -65,6 +77,9 @@ class VectorEnv {
   std::vector<uint8_t> terminated_, truncated_;
   std::vector<StepInfo> info_;
   std::vector<EpisodeStats> running_, finished_;
+  // run(): each environment's finished episodes with the step they ended at, merged into
+  // finished_ in step order once every environment is done.
+  std::vector<std::vector<std::pair<int, EpisodeStats>>> ended_;
   std::function<void(int, int)> step_block_;
   const float* actions_ = nullptr;
 };

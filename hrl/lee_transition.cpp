@@ -7,12 +7,12 @@
 namespace segue {
 
 LeeTransitionEnv::LeeTransitionEnv(const EnvFactory& make_env, const std::vector<Skill>& skills,
-                                   const MetaController& meta, int transition, StartStates starts,
+                                   const MetaController& meta, int transition, StartStates starts, int max_steps,
                                    int max_subtask_steps)
     : to_(meta.transitions().at(transition).to),
       inner_(make_env(), std::move(starts), meta.transitions()[transition], skills[to_].obs_begin,
              skills[to_].obs_end),
-      max_subtask_steps_(max_subtask_steps),
+      max_steps_(max_steps), max_subtask_steps_(max_subtask_steps),
       pi_b_(skills, meta, {}, SwitchRule::IntervalEnd) {
   spec_ = inner_.spec();
   spec_.name = inner_.task().spec().name + " (Lee transition)";
@@ -59,7 +59,9 @@ StepResult LeeTransitionEnv::step(const float* action, float* obs) {
   } else {
     r = inner_.step(action, obs);
     current_.states.insert(current_.states.end(), obs, obs + D);
-    hand_over = r.truncated && !r.terminated;  // the interval ended: pi_b takes over
+    const int steps = int(current_.states.size()) / D - 1;
+    // The interval ended, or pi_ab's steps are spent: pi_b takes over.
+    hand_over = !r.terminated && (r.truncated || (max_steps_ > 0 && steps >= max_steps_));
   }
   bool success = false;
   if (hand_over) {
@@ -82,8 +84,9 @@ LeeTrainer::LeeTrainer(const TransitionPolicyConfig& tp, const LeeConfig& c, Vec
                        const Distributed& group)
     : cfg_(c), envs_(envs),
       ppo_(tp.ppo, tp.network(envs.spec(), next), envs, seed, group),
-      obs_dim_(envs.spec().obs_dim) {
+      obs_dim_(envs.spec().obs_dim), rms_(obs_dim_, 5.0, 1e-4) {
   if (expert.obs_dim != obs_dim_) throw Error("Lee transition policy: T_b's observation size differs from pi_b's");
+  if (expert.size() == 0) throw Error("Lee transition policy: T_b is empty (no state of pi_b to label 1)");
   if (tp.init_from_next) ppo_.init_actor(next);
   // The termination head starts rarely firing either way: at ~0 (random weights) it would end
   // about half the episodes at their first step, each then costing a whole run of pi_b.
@@ -95,14 +98,17 @@ LeeTrainer::LeeTrainer(const TransitionPolicyConfig& tp, const LeeConfig& c, Vec
   ps.decay = c.decay;
   p_ = ProximityPredictor(ps);
   opt_ = std::make_unique<torch::optim::Adam>(p_->parameters(), torch::optim::AdamOptions(c.lr));
-  auto e = torch::from_blob(const_cast<float*>(expert.obs.data()), {int64_t(expert.size()), int64_t(obs_dim_)});
-  mean_ = e.mean(0);
-  std_ = e.std(0).clamp_min(1e-2);
-  for (int i = 0; i < expert.size(); ++i) add(&expert.obs[size_t(i) * obs_dim_], 1.0f);  // pi_b's own states
+  // T_b, pi_b's own states, stay label-1 data for good: half of every positive batch.
+  tb_ = expert.obs;
+  rms_.update(tb_.data(), expert.size());
   ppo_.set_reward_hook([this](RolloutBuffer& buf) { reward(buf); });
 }
 
-torch::Tensor LeeTrainer::normalize(const torch::Tensor& obs) const { return ((obs - mean_) / std_).clamp(-5.0, 5.0); }
+torch::Tensor LeeTrainer::normalize(const torch::Tensor& obs) const {
+  auto mean = torch::tensor(std::vector<float>(rms_.mean().begin(), rms_.mean().end()));
+  auto inv_std = torch::tensor(rms_.inv_std());
+  return ((obs - mean) * inv_std).clamp(-rms_.clip(), rms_.clip());
+}
 
 void LeeTrainer::add(const float* s, float label) {
   const int64_t cap = cfg_.max_rows;
@@ -122,14 +128,18 @@ void LeeTrainer::add(const float* s, float label) {
 void LeeTrainer::reward(RolloutBuffer& buf) {
   // 1. Label the finished episodes and fit P_b by least squares on both classes.
   int episodes = 0, successes = 0;
+  labelled_.clear();
   for (int i = 0; i < envs_.size(); ++i)
     for (auto& e : static_cast<LeeTransitionEnv&>(envs_.env(i)).take_finished()) {
       const int T = int(e.states.size()) / obs_dim_;
       std::vector<float> labels = proximity_labels(T, e.success, cfg_.decay);
       for (int t = 0; t < T; ++t) add(&e.states[size_t(t) * obs_dim_], labels[t]);
+      labelled_.insert(labelled_.end(), e.states.begin(), e.states.end());
       ++episodes, successes += e.success;
     }
   const Distributed& group = ppo_.group();
+  // P_b's inputs are normalised by the statistics of every state it has been fitted on.
+  rms_.update(labelled_.data(), int64_t(labelled_.size()) / obs_dim_, &group);
   double counts[2] = {double(episodes), double(successes)};
   group.sum(counts, 2);
   last_ = Stats();
@@ -138,9 +148,19 @@ void LeeTrainer::reward(RolloutBuffer& buf) {
   auto pos = torch::from_blob(pos_.data(), {np, int64_t(obs_dim_)});
   auto pos_y = torch::from_blob(pos_label_.data(), {np});
   auto neg = torch::from_blob(neg_.data(), {nn, int64_t(obs_dim_)});
+  const int64_t tb_n = int64_t(tb_.size()) / obs_dim_;
+  auto tb = torch::from_blob(tb_.data(), {tb_n, int64_t(obs_dim_)});
+  // Positives: half T_b, half successful transitions' states (all T_b before there are any).
+  const int64_t from_tb = np > 0 ? cfg_.batch / 2 : cfg_.batch;
   for (int step = 0; step < cfg_.steps; ++step) {
-    auto pi = torch::randint(np, {cfg_.batch}, torch::kLong);
-    torch::Tensor x = normalize(pos.index_select(0, pi)), y = pos_y.index_select(0, pi);
+    auto ti = torch::randint(tb_n, {from_tb}, torch::kLong);
+    torch::Tensor x = tb.index_select(0, ti), y = torch::ones({from_tb});
+    if (np > 0) {
+      auto pi = torch::randint(np, {cfg_.batch - from_tb}, torch::kLong);
+      x = torch::cat({x, pos.index_select(0, pi)});
+      y = torch::cat({y, pos_y.index_select(0, pi)});
+    }
+    x = normalize(x);
     if (nn > 0) {
       auto ni = torch::randint(nn, {cfg_.batch}, torch::kLong);
       x = torch::cat({x, normalize(neg.index_select(0, ni))});
@@ -160,6 +180,12 @@ void LeeTrainer::reward(RolloutBuffer& buf) {
   auto done = torch::from_blob(buf.dones.data(), {M}, torch::kUInt8).to(torch::kFloat32);
   auto r = (p1 - p0 + done * p1).to(torch::kFloat64).contiguous();
   std::copy(r.data_ptr<double>(), r.data_ptr<double>() + M, buf.raw_rewards.begin());
+}
+
+Policy LeeTrainer::policy() const {
+  Policy p = ppo_.policy();
+  p.set_max_steps(cfg_.max_steps);
+  return p;
 }
 
 LeeTrainer::Stats LeeTrainer::iterate() {
@@ -188,6 +214,7 @@ void LeeTrainer::save(const std::string& path, const std::string& note) const {
     ar.write("proximity_positive_label", rows_of(pos_label_, 1));
     ar.write("proximity_negative", rows_of(neg_, obs_dim_));
     ar.write("proximity_seen", torch::tensor(std::vector<int64_t>{pos_n_, neg_n_}));
+    rms_.save(ar, "proximity_obs_rms_");
   });
 }
 
@@ -198,8 +225,10 @@ void LeeTrainer::load(const std::string& path) {
     ar.read("proximity_optimizer", o);
     p_->load(p);
     opt_->load(o);
-    torch::Tensor seen, pos, label, neg;
-    if (!ar.try_read("proximity_seen", seen)) return;  // an older checkpoint
+    torch::Tensor seen, pos, label, neg, count;
+    if (!ar.try_read("proximity_seen", seen) || !ar.try_read("proximity_obs_rms_count", count))
+      throw Error(path + ": a Lee checkpoint of an older layout (T_b in the labelled ring, no input normaliser); "
+                  "remove it to train this stage afresh");
     ar.read("proximity_positive", pos);
     ar.read("proximity_positive_label", label);
     ar.read("proximity_negative", neg);
@@ -207,6 +236,7 @@ void LeeTrainer::load(const std::string& path) {
       throw Error(path + ": the proximity predictor's states have another width than pi_b's observation");
     pos_ = to_floats(pos), pos_label_ = to_floats(label), neg_ = to_floats(neg);
     pos_n_ = seen[0].item<int64_t>(), neg_n_ = seen[1].item<int64_t>();
+    rms_.load(ar, "proximity_obs_rms_");
   });
 }
 

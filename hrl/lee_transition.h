@@ -3,7 +3,8 @@
 // policies"): a transition policy rewarded by a proximity predictor P_b(s) in [0, 1], how
 // close s is to states from which pi_b succeeds, and ending itself with a termination
 // output. Per episode from a state of S_a:
-//   pi_ab acts until its extra output is positive (or the interval ends, or a fall);
+//   pi_ab acts until its extra output is positive (or the interval ends, or its
+//   lee.max_steps are spent, or a fall);
 //   pi_b then runs its subtask; success labels the episode's states 0.95^k (k steps
 //   before the hand-over), failure labels them 0; pi_b's own states (T_b) are labelled 1.
 //   Rewards: P(s_{t+1}) - P(s_t), plus P(s_T) at the end (algorithms/proximity_predictor.h).
@@ -12,6 +13,7 @@
 
 #include "algorithms/ppo.h"
 #include "algorithms/proximity_predictor.h"
+#include "core/running_mean_std.h"
 #include "hrl/collection.h"
 #include "hrl/pipeline_config.h"
 #include "hrl/transition_env.h"
@@ -23,9 +25,10 @@ namespace segue {
 class LeeTransitionEnv : public Env {
  public:
   // Transition `transition` of `meta` in environments of `make_env`, from S_a's states;
-  // pi_b's run after a hand-over is cut, and counted a success, after max_subtask_steps.
+  // pi_ab hands over after at most `max_steps` steps (0: when the interval ends); pi_b's
+  // run after a hand-over is cut, and counted a success, after max_subtask_steps.
   LeeTransitionEnv(const EnvFactory& make_env, const std::vector<Skill>& skills, const MetaController& meta,
-                   int transition, StartStates starts, int max_subtask_steps);
+                   int transition, StartStates starts, int max_steps, int max_subtask_steps);
   const EnvSpec& spec() const override { return spec_; }
   void reset(uint64_t seed, float* obs) override;
   void reset(float* obs) override;
@@ -47,7 +50,7 @@ class LeeTransitionEnv : public Env {
  private:
   int to_;
   TransitionEnv inner_;  // S_a starts, pi_b's slice, the interval's end
-  int max_subtask_steps_;
+  int max_steps_, max_subtask_steps_;
   TransitionController pi_b_;  // pi_b alone judges a hand-over, as in Lee et al.
   EnvSpec spec_;
   std::vector<float> after_;
@@ -68,13 +71,15 @@ class LeeTrainer {
     double predictor_loss = 0, handover_success = NAN;
   };
   Stats iterate();
-  Policy policy() const { return ppo_.policy(); }
+  // pi_ab with its log std and lee.max_steps, which evaluation follows.
+  Policy policy() const;
   const PPO& ppo() const { return ppo_; }
-  // The checkpoint holds P_b, its optimiser and its labelled states too, so a resumed
-  // stage fits P_b on all it had seen (older checkpoints without them: T_b and new episodes).
+  // The checkpoint holds P_b, its optimiser, its labelled states and its input
+  // normaliser too, so a resumed stage fits P_b on all it had seen.
   void save(const std::string& path, const std::string& note) const;
   void load(const std::string& path);
-  // Labelled states seen so far (positive: T_b's and successful episodes'), ring overwrites included.
+  // Transitions' states labelled so far (positive: from successful episodes; T_b's apart),
+  // ring overwrites included.
   int64_t positives_seen() const { return pos_n_; }
   int64_t negatives_seen() const { return neg_n_; }
 
@@ -88,9 +93,11 @@ class LeeTrainer {
   PPO ppo_;
   ProximityPredictor p_{nullptr};
   std::unique_ptr<torch::optim::Adam> opt_;
-  torch::Tensor mean_, std_;
   int obs_dim_;
-  std::vector<float> pos_, pos_label_, neg_;  // labelled states: rings of max_rows
+  RunningMeanStd rms_;   // P_b's input normaliser: T_b's and every labelled state's moments, clip 5, std >= 0.01
+  std::vector<float> tb_;                     // T_b: label 1, kept whole
+  std::vector<float> pos_, pos_label_, neg_;  // transitions' labelled states: rings of max_rows
+  std::vector<float> labelled_;               // one rollout's labelled states (scratch)
   int64_t pos_n_ = 0, neg_n_ = 0;
   Stats last_;
 };

@@ -224,7 +224,7 @@ int train_lee(const CompositeRecipe& r, int t, const StartStates& starts, const 
   const Skill& b = r.skills[r.meta.transitions()[t].to];
   const int subtask_steps = r.pipeline.switching.max_subtask_steps;
   const Shard share = o.group->shard(cfg.ppo.num_envs, "transition.ppo.num_envs");
-  VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r.make_env, r.skills, r.meta, t, starts, subtask_steps); }, share.count,
+  VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r.make_env, r.skills, r.meta, t, starts, r.pipeline.lee.max_steps, subtask_steps); }, share.count,
                  o.threads, share.first);
   LeeTrainer trainer(cfg, r.pipeline.lee, envs, demonstrations_of(r, t, dir), b.policy,
                      mix_seed(r.pipeline.seed, 300 + t), *o.group);

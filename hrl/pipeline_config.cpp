@@ -89,6 +89,7 @@ LeeConfig LeeConfig::read(const Section& s) {
   c.decay = s.get("decay", c.decay, Range::open_closed(0, 1));
   c.max_rows = s.get("max_rows", c.max_rows, Range::positive());
   c.termination_bias = s.get("termination_bias", c.termination_bias, Range::any());
+  c.max_steps = s.get("max_steps", c.max_steps, Range::non_negative());
   c.total_steps = s.get("total_steps", c.total_steps, Range::non_negative());
   return c;
 }

@@ -95,6 +95,7 @@ struct LeeConfig {
   double decay = 0.95;         // label 0.95^k, k steps before a successful hand-over
   int max_rows = 200000;       // labelled states kept per class (a ring)
   float termination_bias = -1.0f;  // initial termination output (mean): rarely at first
+  int max_steps = 100;         // pi_ab hands over after at most this many steps (Lee et al.'s; 0: the interval only)
   // Lee's policy trains with pi_ab's `transition:` settings (network, PPO, start); only its
   // budget may differ: 0 takes transition.ppo.total_steps.
   int64_t total_steps = 0;

@@ -36,6 +36,7 @@ bool TransitionController::hand_over(const float* obs) {
     return meta_.transitions()[transition_].progress(entry_features_.data(), features_.data(), steps_) >=
            hand_over_at_;
   const TransitionArtefacts& a = artefacts_[transition_];
+  if (rule_ == SwitchRule::TerminationHead && a.policy->max_steps() > 0 && steps_ >= a.policy->max_steps()) return true;
   if (rule_ == SwitchRule::QNetwork && a.q) {
     float q[2];
     a.q->act(obs, 1, q);
@@ -85,11 +86,16 @@ void TransitionController::act(const Env& env, const float* obs, float* action) 
   const Policy& pi_ab = *artefacts_[transition_].policy;
   const int A = env.spec().act_dim;
   out_.resize(pi_ab.act_dim());
-  pi_ab.act(obs + b.obs_begin, 1, out_.data());
+  const bool sample = rule_ == SwitchRule::TerminationHead && !pi_ab.log_std().empty();
+  pi_ab.act(obs + b.obs_begin, 1, out_.data(), sample ? &rng_ : nullptr);
   ++steps_;
+  // Lee et al.: the transition policy's own termination output hands over at once.
+  if (rule_ == SwitchRule::TerminationHead && pi_ab.act_dim() > A && out_[A] > 0.0f) {
+    transition_ = acted_ = -1;
+    b.policy.act(obs + b.obs_begin, 1, action);
+    return;
+  }
   std::copy(out_.begin(), out_.begin() + A, action);
-  // Lee et al.: the transition policy's own termination output ends it from the next step.
-  if (rule_ == SwitchRule::TerminationHead && pi_ab.act_dim() > A && out_[A] > 0.0f) transition_ = -1;
 }
 
 std::string TransitionController::in_control() const {

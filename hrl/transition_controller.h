@@ -5,7 +5,11 @@
 //   IntervalEnd      (With TP):       when the interval ends;
 //   QNetwork         (With TP + Q):   as soon as q_ab values switch above stay;
 //   TerminationHead  (Lee et al.):    when pi_ab's extra output (its termination head) is
-//                                     positive.
+//                                     positive (pi_b then acts from that state, as in
+//                                     training), or after the policy's max_steps;
+//                                     pi_ab's actions, that output included, are sampled
+//                                     from its Gaussian as in its training (on the mean
+//                                     where the file has no log std).
 // Control always passes to pi_b when the interval ends (or its max_steps are spent). A
 // transition without a trained pi_ab is taken as Without TP: pi_b from the interval's start.
 //
@@ -47,8 +51,7 @@ class TransitionController : public Controller {
   void act(const Env& env, const float* obs, float* action) override;
   int skill() const { return skill_; }
   // Who chose the last action: the skill's name, or "a->b" where transition a->b's pi_ab
-  // (or, at a random hand-over point, Without TP's pi_a) did, even if it ended the
-  // transition there (Lee et al.'s termination output).
+  // (or, at a random hand-over point, Without TP's pi_a) did.
   std::string in_control() const override;
   int transition() const { return transition_; }  // the transition pi_ab (or pi_a) drives, or -1
   // The transition whose interval the last act() entered (control passed to pi_ab, or

@@ -119,7 +119,7 @@ class DataParallel : public TempDirTest {
 // rollout. After one iteration the checkpoints agree to float tolerance; over three, the
 // normalisers' moments merged over ranks round differently, conjugate gradient amplifies
 // that, and the walker's chaotic episodes drift apart a little, so the metrics are
-// compared to 1e-3.
+// compared to 5e-3.
 TEST_F(DataParallel, TwoRanksTakeTheTrpoStepOneProcessTakes) {
   for (int iterations : {1, 3}) {
     auto trpo = [&](const std::string& name) {
@@ -145,7 +145,7 @@ TEST_F(DataParallel, TwoRanksTakeTheTrpoStepOneProcessTakes) {
     auto m1 = csv(path(one) + "/metrics.csv"), m2 = csv(path(two) + "/metrics.csv");
     ASSERT_EQ(m1.size(), size_t(iterations + 1));
     ASSERT_EQ(m1.size(), m2.size());
-    const double tol = iterations == 1 ? 1e-5 : 1e-3;
+    const double tol = iterations == 1 ? 1e-5 : 5e-3;
     for (size_t r = 1; r < m1.size(); ++r)
       for (size_t c = 0; c < m1[0].size(); ++c)
         if (!timing(m1[0][c]))

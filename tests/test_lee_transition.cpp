@@ -16,23 +16,23 @@
 
 namespace segue {
 
-// A resumed Lee stage keeps the proximity predictor's labelled states (T_b's and every
-// finished episode's), not only its weights.
+// A resumed Lee stage keeps the proximity predictor's labelled states (every finished
+// episode's; T_b's are the recipe's), not only its weights.
 TEST_F(TransitionTraining, LeeCheckpointKeepsThePredictorsLabelledStates) {
   CompositeRecipe r = tiny();
   const Skill& b = r.skills[r.meta.transitions()[0].to];
   StartStates starts = collect_start_states(r, 0, 6, 1);
   Demonstrations expert = collect_demonstrations(r, 0, 300, 2);
   auto envs = [&] {
-    return std::make_unique<VectorEnv>([&] { return std::make_unique<LeeTransitionEnv>(r.make_env, r.skills, r.meta, 0, starts, 500); },
+    return std::make_unique<VectorEnv>([&] { return std::make_unique<LeeTransitionEnv>(r.make_env, r.skills, r.meta, 0, starts, 0, 500); },
                                        r.pipeline.transition.ppo.num_envs, 1);
   };
   auto first_envs = envs();
   LeeTrainer first(r.pipeline.transition, r.pipeline.lee, *first_envs, expert, b.policy, 5);
-  EXPECT_EQ(first.positives_seen(), expert.size());
+  EXPECT_EQ(first.positives_seen(), 0);  // T_b is kept apart
   EXPECT_EQ(first.negatives_seen(), 0);
   first.iterate(), first.iterate();
-  ASSERT_GT(first.positives_seen() + first.negatives_seen(), expert.size()) << "no episode was labelled";
+  ASSERT_GT(first.positives_seen() + first.negatives_seen(), 0) << "no episode was labelled";
   first.save(path("lee_checkpoint.pt"), "test");
   auto again_envs = envs();
   LeeTrainer again(r.pipeline.transition, r.pipeline.lee, *again_envs, expert, b.policy, 5);
@@ -51,7 +51,7 @@ TEST_F(TransitionTraining, LeeTerminationHeadStartsAtItsBiasFromRandomWeights) {
     const Skill& b = r.skills[r.meta.transitions()[0].to];
     StartStates starts = collect_start_states(r, 0, 4, 1);
     Demonstrations expert = collect_demonstrations(r, 0, 100, 2);
-    VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r.make_env, r.skills, r.meta, 0, starts, 500); }, 2, 1);
+    VectorEnv envs([&] { return std::make_unique<LeeTransitionEnv>(r.make_env, r.skills, r.meta, 0, starts, 0, 500); }, 2, 1);
     LeeTrainer lee(r.pipeline.transition, r.pipeline.lee, envs, expert, b.policy, 5);
     const int D = envs.spec().obs_dim, A = envs.spec().act_dim;
     auto obs = random_obs(16, D, 3);
@@ -65,7 +65,7 @@ TEST_F(TransitionTraining, LeeTerminationHeadStartsAtItsBiasFromRandomWeights) {
 TEST_F(TransitionTraining, LeeEpisodesEndAtTheTerminationOutputWithPiBsOutcome) {
   CompositeRecipe r = tiny();
   StartStates starts = collect_start_states(r, 0, 4, 1);
-  LeeTransitionEnv env(r.make_env, r.skills, r.meta, 0, starts, 500);
+  LeeTransitionEnv env(r.make_env, r.skills, r.meta, 0, starts, 0, 500);
   ASSERT_EQ(env.spec().act_dim, 7);  // pi_b's 6 and the termination output
   std::vector<float> obs(env.spec().obs_dim), act(7, 0.0f);
   for (uint64_t seed = 0; seed < 4; ++seed) {
@@ -92,6 +92,24 @@ TEST_F(TransitionTraining, LeeEpisodesEndAtTheTerminationOutputWithPiBsOutcome) 
     EXPECT_EQ(episodes[0].states.size(), 3u * obs.size());  // s_0, s_1, s_2 = s_T
     EXPECT_EQ(episodes[0].success, sr.info.success);
   }
+}
+
+// lee.max_steps: pi_ab hands over to pi_b after that many steps even if its termination
+// output never fires, as the reference caps a transition (at evaluation:
+// test_transition_controller.cpp).
+TEST_F(TransitionTraining, LeeHandsOverAfterMaxSteps) {
+  CompositeRecipe r = tiny();
+  StartStates starts = collect_start_states(r, 0, 4, 1);
+  LeeTransitionEnv env(r.make_env, r.skills, r.meta, 0, starts, 3, 500);
+  std::vector<float> obs(env.spec().obs_dim), act(7, 0.0f);
+  act[6] = -1.0f;  // never terminates by itself
+  env.reset(0, obs.data());
+  ASSERT_FALSE(env.step(act.data(), obs.data()).done());
+  ASSERT_FALSE(env.step(act.data(), obs.data()).done());
+  EXPECT_TRUE(env.step(act.data(), obs.data()).terminated);
+  auto episodes = env.take_finished();
+  ASSERT_EQ(episodes.size(), 1u);
+  EXPECT_EQ(episodes[0].states.size(), 4u * obs.size());  // s_0 .. s_3
 }
 
 }  // namespace segue

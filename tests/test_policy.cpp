@@ -115,6 +115,42 @@ TEST_F(PolicyFiles, TorchScriptExportRoundTrip) {
   EXPECT_EQ(torch::jit::load(path("p.pt")).attr("source").toStringRef(), "hurdle walk-jump policy.pt");
 }
 
+// The Gaussian policy's log std travels with both files, and act() with noise samples
+// N(mu, exp(log_std)^2) around the mean action (then bounded); a step cap travels too.
+TEST_F(PolicyFiles, SampledActionsFollowTheSavedLogStd) {
+  Policy mem = train_and_save();
+  ASSERT_EQ(mem.log_std().size(), 6u);
+  for (const char* file : {"p.pt", "ckpt.pt"}) {
+    const auto saved = Policy::load(path(file)).log_std();
+    ASSERT_EQ(saved.size(), 6u) << file;
+    for (int j = 0; j < 6; ++j) EXPECT_FLOAT_EQ(saved[j], mem.log_std()[j]) << file;
+  }
+  // Wide bounds, so that no sample is clipped; log std -1 on every action.
+  Policy p(mem.mlp(), mem.obs_mean(), mem.obs_inv_std(), 10.0f, std::vector<float>(6, -1e9f),
+           std::vector<float>(6, 1e9f));
+  std::vector<float> obs(26, 0.1f), mu(6), a(6);
+  p.act(obs.data(), 1, mu.data());
+  Rng rng(3);
+  EXPECT_THROW(p.act(obs.data(), 1, a.data(), &rng), Error);  // no log std set
+  p.set_log_std(std::vector<float>(6, -1.0f));
+  const int n = 20000;
+  std::vector<double> sum(6, 0.0), squares(6, 0.0);
+  for (int k = 0; k < n; ++k) {
+    p.act(obs.data(), 1, a.data(), &rng);
+    for (int j = 0; j < 6; ++j) sum[j] += a[j] - mu[j], squares[j] += (a[j] - mu[j]) * (a[j] - mu[j]);
+  }
+  for (int j = 0; j < 6; ++j) {
+    EXPECT_NEAR(sum[j] / n, 0.0, 0.01) << j;                       // standard error 0.0026
+    EXPECT_NEAR(std::sqrt(squares[j] / n), std::exp(-1.0), 0.01) << j;
+  }
+  EXPECT_THROW(p.set_log_std(std::vector<float>(5, 0.0f)), Error);
+  // A transition policy's step cap travels with the exported file too (none: 0).
+  EXPECT_EQ(Policy::load(path("p.pt")).max_steps(), 0);
+  mem.set_max_steps(100);
+  mem.export_torchscript(path("p.pt"));
+  EXPECT_EQ(Policy::load(path("p.pt")).max_steps(), 100);
+}
+
 // policy.ignore_obs: the trained policy, its checkpoint and its TorchScript all act the
 // same whatever the ignored inputs (here the walker's qacc) hold.
 TEST_F(PolicyFiles, IgnoredInputsDoNotMoveTheActionInAnyExport) {

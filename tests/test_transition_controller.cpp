@@ -17,6 +17,52 @@
 
 namespace segue {
 
+// Lee et al.: pi_ab's actions are sampled, and it hands over when its termination output
+// fires or after the policy's max_steps (3 here); a termination output that never fires
+// drives exactly max_steps steps.
+TEST_F(TransitionTraining, LeeHandsOverAtItsTerminationOrAfterMaxSteps) {
+  CompositeRecipe r = tiny();
+  const Transition& tr = r.meta.transitions()[0];
+  const Policy& b = r.skills[tr.to].policy;
+  auto termination_at = [&](float bias) {  // pi_ab's actions 0, termination output `bias`
+    std::vector<float> out_bias(7, 0.0f);
+    out_bias[6] = bias;
+    Policy p(EigenMlp({torch::zeros({7, b.obs_dim()})}, {torch::tensor(out_bias)}, Activation::Tanh), b.obs_mean(),
+             b.obs_inv_std(), 10.0f, std::vector<float>(7, -1.0f), std::vector<float>(7, 1.0f));
+    p.set_log_std(std::vector<float>(7, -1.0f));
+    p.set_max_steps(3);
+    return p;
+  };
+  auto env = r.make_env();
+  std::vector<float> obs(r.spec.obs_dim), act(6);
+  auto steps_driven = [&](const Policy& pi_ab, uint64_t noise_seed) {
+    std::vector<TransitionArtefacts> art(r.meta.transitions().size());
+    art[0].policy = pi_ab;
+    TransitionController lee(r.skills, r.meta, art, SwitchRule::TerminationHead);
+    for (uint64_t seed = 0; seed < 20; ++seed) {  // an episode that starts walking forward
+      env->reset(seed, obs.data());
+      lee.reset(*env, obs.data(), noise_seed);
+      if (lee.skill() == tr.from) break;
+    }
+    EXPECT_EQ(lee.skill(), tr.from);
+    int driven = 0;
+    for (int t = 0; t < 300; ++t) {
+      lee.act(*env, obs.data(), act.data());
+      driven += lee.transition() == 0;
+      if (env->step(act.data(), obs.data()).done()) break;
+    }
+    return driven;
+  };
+  // Termination mean -5, std e^-1: never fires (13 standard deviations).
+  EXPECT_EQ(steps_driven(termination_at(-5.0f), 0), 3);
+  // Mean 0: fires at each step with probability 1/2, so over 40 episodes (noise seeds)
+  // pi_ab is cut short of the cap about 7/8 of the time, each time by its own output.
+  int short_of_cap = 0;
+  for (uint64_t k = 0; k < 40; ++k) short_of_cap += steps_driven(termination_at(0.0f), k) < 3;
+  EXPECT_GE(short_of_cap, 25);  // binomial(40, 7/8): 35 expected, sd 2.1
+  EXPECT_LT(short_of_cap, 40);
+}
+
 TEST_F(TransitionTraining, ControllersHandOverWhereTheRecipeSays) {
   CompositeRecipe r = tiny();
   const Transition& tr = r.meta.transitions()[0];

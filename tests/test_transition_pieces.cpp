@@ -116,7 +116,7 @@ TEST(SwitchQNetwork, DoubleDqnTargetByHand) {
   EXPECT_TRUE(torch::equal(online->forward(next), target->forward(next)));
 }
 
-TEST(ProximityPredictor, LabelsRewardsAndClippedOutput) {
+TEST(ProximityPredictor, LabelsRewardsClippedOutputAndUnclippedLoss) {
   auto y = proximity_labels(4, true, 0.95);
   ASSERT_EQ(y.size(), 4u);
   EXPECT_NEAR(y[0], 0.857375, 1e-6);
@@ -140,6 +140,8 @@ TEST(ProximityPredictor, LabelsRewardsAndClippedOutput) {
   EXPECT_FLOAT_EQ(out[1].item<float>(), 0.4f);
   EXPECT_FLOAT_EQ(out[2].item<float>(), 1.0f);
   EXPECT_NEAR(p->loss(torch::tensor({{0.4f}}), torch::tensor({1.0f})).item<float>(), 0.36, 1e-6);
+  // The loss sees the unclipped output: a positive state at -2 costs (-2 - 1)^2, not (0 - 1)^2.
+  EXPECT_NEAR(p->loss(torch::tensor({{-2.0f}}), torch::tensor({1.0f})).item<float>(), 9.0, 1e-5);
 }
 
 }  // namespace segue
