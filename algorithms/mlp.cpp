@@ -68,7 +68,6 @@ EigenMlp::EigenMlp(const torch::nn::Sequential& net, Activation act) : act_(act)
       biases_.emplace_back(Eigen::Map<const Eigen::RowVectorXf>(b.data_ptr<float>(), b.size(0)));
     }
   }
-  scratch_.resize(weights_.size());
 }
 
 EigenMlp::EigenMlp(const std::vector<torch::Tensor>& ws, const std::vector<torch::Tensor>& bs,
@@ -83,7 +82,6 @@ EigenMlp::EigenMlp(const std::vector<torch::Tensor>& ws, const std::vector<torch
     weights_.emplace_back(Eigen::Map<const RowMatrix>(w.data_ptr<float>(), w.size(0), w.size(1)));
     biases_.emplace_back(Eigen::Map<const Eigen::RowVectorXf>(b.data_ptr<float>(), b.size(0)));
   }
-  scratch_.resize(weights_.size());
 }
 
 void EigenMlp::forward(const float* in, int batch, float* out, Workspace* ws) const {
