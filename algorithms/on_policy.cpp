@@ -104,6 +104,15 @@ const RolloutBuffer& OnPolicyLearner::whole_rollout() {
   return whole_;
 }
 
+void OnPolicyLearner::run_both(const std::function<void()>& a, const std::function<void()>& b) {
+  if (rollout_cfg_.policy_lag == 0 && envs_.pool().size() > 1) {
+    envs_.pool().parallel_for(2, [&](int i, int) { i == 0 ? a() : b(); });
+  } else {
+    a();
+    b();
+  }
+}
+
 void OnPolicyLearner::share_leader_update(const std::vector<torch::Tensor>& params, double* values, int n) const {
   if (group_.single()) return;
   torch::NoGradGuard no_grad;

@@ -155,6 +155,10 @@ class OnPolicyLearner : public Learner {
   // the first n), mean and standard deviation taken over those rows (out is resized).
   static void standardized_advantages(const std::vector<float>& advantages, const int64_t* rows, int64_t n,
                                       std::vector<float>& out);
+  // Runs a() and b(), two independent parts of an update (one network's work each), at
+  // once on the environments' pool when it has a second thread and no rollout runs beside
+  // the update (policy_lag 0); else one after the other. Either way the same results.
+  void run_both(const std::function<void()>& a, const std::function<void()>& b);
   int64_t global_rows() const { return int64_t(buf_.T) * global_envs_; }
   void refresh_inference_copy();
 

@@ -59,10 +59,12 @@ void PPO::update(IterationStats& stats) {
       for (const torch::Tensor& minibatch : shuffled_minibatches(cfg_.minibatch_size)) {
         const int n = int(minibatch.numel());
         gather(rollout, minibatch.data_ptr<int64_t>(), n);
-        const auto& mu = actor_.forward(mb_.obs.data(), n);
-        const auto& value = critic_.forward(mb_.obs.data(), n);
+        // The actor's and the critic's passes share nothing: side by side where they can.
+        const MlpBackprop::RowMatrix *mu = nullptr, *value = nullptr;
+        run_both([&] { mu = &actor_.forward(mb_.obs.data(), n); },
+                 [&] { value = &critic_.forward(mb_.obs.data(), n); });
         dmu_.resize(n, k), dvalue_.resize(n, 1);
-        const PpoMinibatch batch{n, k, mu.data(), value.data(), mb_.actions.data(), mb_.old_log_prob.data(),
+        const PpoMinibatch batch{n, k, mu->data(), value->data(), mb_.actions.data(), mb_.old_log_prob.data(),
                                  mb_.advantage.data(), mb_.returns.data(), log_std.data_ptr<float>(),
                                  spec.act_low.data(), spec.act_high.data()};
         if (!log_std.grad().defined()) log_std.mutable_grad() = torch::zeros_like(log_std);
@@ -72,8 +74,7 @@ void PPO::update(IterationStats& stats) {
           throw Error("PPO loss became " + std::to_string(loss.total) + " at iteration " +
                       std::to_string(iteration_ + 1) + " (task '" + envs_.spec().name +
                       "'); the last checkpoint is kept: lower ppo.lr or check the task's rewards");
-        actor_.backward(dmu_);
-        critic_.backward(dvalue_);
+        run_both([&] { actor_.backward(dmu_); }, [&] { critic_.backward(dvalue_); });
         clip_grad_norm(params, cfg_.max_grad_norm);
         adam_step(*optimizer_);
         if (cfg_.min_log_std > -20.0) {

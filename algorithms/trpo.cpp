@@ -41,10 +41,8 @@ void TRPO::update(IterationStats& stats) {
   const RolloutBuffer& rollout = whole_rollout();
   // The same minibatches in every run, whatever a reward hook drew before.
   torch::manual_seed(mix_seed(seed_, 2 * iteration_ + 2) ^ 0x9e3779b9ULL);
-  if (group_.leader()) {
-    policy_step(rollout, stats);
-    fit_value(rollout, stats);
-  }
+  if (group_.leader())  // the two networks' parts share nothing: side by side where they can
+    run_both([&] { policy_step(rollout, stats); }, [&] { fit_value(rollout, stats); });
   double values[4] = {stats.policy_loss, stats.approx_kl, stats.step_size, stats.value_loss};
   share_leader_update(net_->parameters(), values, 4);
   stats.policy_loss = values[0], stats.approx_kl = values[1], stats.step_size = values[2], stats.value_loss = values[3];

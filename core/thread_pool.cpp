@@ -3,6 +3,7 @@
 #include <cstdlib>
 
 #include <ATen/Parallel.h>
+#include <omp.h>
 
 #include <algorithm>
 
@@ -18,7 +19,14 @@ int resolve_threads(int requested) {
 
 ThreadPool::ThreadPool(int threads) {
   // Workers start from generation 0: a job posted before a thread first runs is still seen.
-  for (int i = 1; i < std::max(1, threads); ++i) workers_.emplace_back([this] { work(0); });
+  // A worker's items are its share of the parallelism: the BLAS calls they make (an
+  // update's two networks, OnPolicyLearner::run_both) run on it alone. OpenMP's thread
+  // count, which OpenBLAS follows, is each thread's own and a new thread's is every core.
+  for (int i = 1; i < std::max(1, threads); ++i)
+    workers_.emplace_back([this] {
+      omp_set_num_threads(1);
+      work(0);
+    });
 }
 
 ThreadPool::~ThreadPool() {

@@ -48,8 +48,9 @@ TEST(PpoLearning, ImprovesReturnOnAShortWalkerHorizon) {
 }
 
 TEST(PpoLearning, TrainingDoesNotDependOnTheThreadCount) {
-  // `threads` only parallelises environment stepping, and LibTorch stays on one thread,
-  // so one and two stepping threads train bit-identical networks.
+  // `threads` parallelises environment stepping and, in the update, the actor's and the
+  // critic's passes (OnPolicyLearner::run_both); LibTorch and BLAS stay on one thread per
+  // caller, so one and two threads train bit-identical networks.
   at::set_num_threads(1);
   ShortWalker s;
   VectorEnv e1(s.make, s.cfg.num_envs, 1), e2(s.make, s.cfg.num_envs, 2);
