@@ -119,16 +119,8 @@ TEST(PolicyLag, TheRolloutBesideAnUpdateIsThePolicysBeforeIt) {
 
 TEST(PolicyLag, TrainingDoesNotDependOnTheThreadCount) {
   at::set_num_threads(1);
-  LaggedWalker<TrpoConfig> s;
-  VectorEnv e1(s.make, s.cfg.num_envs, 1), e2(s.make, s.cfg.num_envs, 2);
-  TRPO a(s.cfg, s.spec, e1, 21), b(s.cfg, s.spec, e2, 21);
-  for (int i = 0; i < 3; ++i) {
-    IterationStats sa = a.iterate(), sb = b.iterate();
-    EXPECT_EQ(sa.episode_return, sb.episode_return) << "iteration " << i;
-    EXPECT_EQ(sa.policy_loss, sb.policy_loss) << "iteration " << i;
-  }
-  auto pa = a.net()->parameters(), pb = b.net()->parameters();
-  for (size_t i = 0; i < pa.size(); ++i) EXPECT_TRUE(torch::equal(pa[i], pb[i])) << "parameter " << i;
+  expect_same_on_one_and_two_threads<TRPO>(LaggedWalker<TrpoConfig>(),
+                                           [](const IterationStats& s) { return s.step_size > 0; });
 }
 
 class PolicyLagCheckpoints : public TempDirTest {
