@@ -41,6 +41,9 @@ OnPolicyLearner::OnPolicyLearner(std::string name, const OnPolicyConfig& config,
     if (rollout_cfg_.policy_lag > 0)
       throw Error(name_ + ".policy_lag: 1 overlaps one process's rollout and update; a data-parallel run (" +
                   std::to_string(group_.size()) + " ranks) takes policy_lag 0");
+    // The other ranks wait while rank 0 updates, so a core of theirs is idle: rank 0 takes
+    // one more thread for the update's second network (run_both) where its pool has one.
+    if (group_.leader() && envs_.pool().size() == 1) update_pool_ = std::make_unique<ThreadPool>(2);
   }
   torch::manual_seed(mix_seed(seed, 0x5e9e));
   net_ = ActorCritic(net);
@@ -105,8 +108,9 @@ const RolloutBuffer& OnPolicyLearner::whole_rollout() {
 }
 
 void OnPolicyLearner::run_both(const std::function<void()>& a, const std::function<void()>& b) {
-  if (rollout_cfg_.policy_lag == 0 && envs_.pool().size() > 1) {
-    envs_.pool().parallel_for(2, [&](int i, int) { i == 0 ? a() : b(); });
+  ThreadPool& pool = update_pool_ ? *update_pool_ : envs_.pool();
+  if (rollout_cfg_.policy_lag == 0 && pool.size() > 1) {
+    pool.parallel_for(2, [&](int i, int) { i == 0 ? a() : b(); });
   } else {
     a();
     b();

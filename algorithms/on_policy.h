@@ -157,7 +157,8 @@ class OnPolicyLearner : public Learner {
                                       std::vector<float>& out);
   // Runs a() and b(), two independent parts of an update (one network's work each), at
   // once on the environments' pool when it has a second thread and no rollout runs beside
-  // the update (policy_lag 0); else one after the other. Either way the same results.
+  // the update (policy_lag 0), or on rank 0's update_pool_; else one after the other.
+  // Either way the same results.
   void run_both(const std::function<void()>& a, const std::function<void()>& b);
   int64_t global_rows() const { return int64_t(buf_.T) * global_envs_; }
   void refresh_inference_copy();
@@ -198,6 +199,7 @@ class OnPolicyLearner : public Learner {
   std::vector<double> running_return_;  // discounted return per env, for reward scaling
   std::vector<float> mean_, log_std_;
   std::vector<EigenMlp::Workspace> actor_workspace_;  // one per environment: they act on any thread
+  std::unique_ptr<ThreadPool> update_pool_;  // rank 0 of several whose own pool has one thread
   std::vector<uint8_t> cut_;  // per step of a rollout [T, N]: ended by a time limit, not a real end
   RewardHook reward_hook_;
   double wall_seconds_ = 0.0;
