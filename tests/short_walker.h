@@ -5,7 +5,6 @@
 
 #include <functional>
 #include <memory>
-#include <string>
 
 #include "algorithms/actor_critic.h"
 #include "algorithms/learner.h"
