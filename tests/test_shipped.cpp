@@ -18,7 +18,7 @@ TEST(Shipped, EveryWalkerPolicyRunsOnItsTask) {
   int checked = 0;
   for (const auto& entry : std::filesystem::directory_iterator(assets_dir() + "/policies/walker")) {
     if (entry.path().extension() != ".pt") continue;
-    // A policy file is named after its task, a variant with a suffix (walker_jump_ppo.pt).
+    // A policy file is named after its task, a variant with a suffix (walker_jump_v2.pt).
     const std::string stem = entry.path().stem().string(), path = entry.path().string();
     std::string task;
     for (const auto& t : task_names())

@@ -16,8 +16,7 @@ import subprocess
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # A manifest entry's skill name is its task's, unless the entry names its task (`task`).
-GROUPS = {"walker": ["walker_forward", "walker_backward", "walker_balance", "walker_crawl", "walker_jump",
-                     "walker_jump_ppo"],
+GROUPS = {"walker": ["walker_forward", "walker_backward", "walker_balance", "walker_crawl", "walker_jump"],
           "jaco": ["jaco_pick", "jaco_catch", "jaco_toss", "jaco_hit"]}
 
 ap = argparse.ArgumentParser()
