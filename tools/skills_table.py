@@ -15,7 +15,7 @@ import os
 import subprocess
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-# A manifest entry's skill name is its task's, unless the entry names its task (`task`).
+# A manifest entry's name is its skill's task (tools/ship_policy.py writes it so).
 GROUPS = {"walker": ["walker_forward", "walker_backward", "walker_balance", "walker_crawl", "walker_jump"],
           "jaco": ["jaco_pick", "jaco_catch", "jaco_toss", "jaco_hit"]}
 
@@ -37,7 +37,7 @@ for group, tasks in GROUPS.items():
         reeval = args.reeval if not args.skills or task in args.skills.split(",") else ""
         for seed in [s for s in reeval.split(",") if s]:
             out = subprocess.run([os.path.join(ROOT, "build", "segue"), "eval", os.path.join(ROOT, e["file"]),
-                                  "--task", e.get("task", task), "--episodes", "50", "--seed", seed, "--json"],
+                                  "--task", task, "--episodes", "50", "--seed", seed, "--json"],
                                  check=True, capture_output=True, text=True).stdout
             r = json.loads(out.strip().splitlines()[-1])
             e.setdefault("reeval", {})[seed] = {k: r[k] for k in ("episodes", "success_rate", "return_mean")}
