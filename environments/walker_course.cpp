@@ -14,6 +14,7 @@ WalkerCourse::Config WalkerCourse::Config::read(const Section& env, Config c) {
   c.pass_bonus = env.get("pass_bonus", c.pass_bonus, Range::non_negative());
   c.speed_weight = env.get("speed_weight", c.speed_weight, Range::non_negative());
   c.height_weight = env.get("height_weight", c.height_weight, Range::non_negative());
+  c.ceiling_height_weight = env.get("ceiling_height_weight", c.ceiling_height_weight, Range::non_negative());
   c.cross_bonus = env.get("cross_bonus", c.cross_bonus, Range::non_negative());
   c.mark_upward_weight = env.get("mark_upward_weight", c.mark_upward_weight, Range::non_negative());
   c.ceiling_zone = env.get("ceiling_zone", c.ceiling_zone, Range::non_negative());
@@ -74,7 +75,7 @@ double WalkerCourse::mark_rewards() {
     const auto marks = curb_marks(obstacles_[k]);
     for (int j = 0; j < 3; ++j) {
       const uint32_t bit = 1u << (3 * k + j);
-      if (!(crossed_ & bit) && foot > marks[j]) crossed_ |= bit, r += ccfg_.cross_bonus;
+      if (!(crossed_ & bit) && foot > marks[j]) crossed_ |= bit, r += ccfg_.cross_bonus * (j + 1) / 3.0;
       if (x_before_ <= marks[j] && marks[j] < torso_x())
         r += ccfg_.mark_upward_weight * std::clamp(z_velocity(), -2.0, 2.0);
     }
@@ -86,7 +87,7 @@ StepResult WalkerCourse::evaluate(const float* action) {
   StepResult r;
   bool ceiling = near_ceiling();
   double v = x_velocity();
-  r.reward = walk_reward(v, action, ccfg_.speed_weight, ceiling ? 0.0 : ccfg_.height_weight);
+  r.reward = walk_reward(v, action, ccfg_.speed_weight, ceiling ? ccfg_.ceiling_height_weight : ccfg_.height_weight);
   bool contact = touching();
   if (contact) r.reward -= ocfg_.contact_penalty;
   r.reward += ccfg_.pass_bonus * update_passed() + mark_rewards();

@@ -19,12 +19,16 @@ class WalkerCourse : public WalkerObstacleEnv {
     bool shuffle = false;                // random order of `kinds` each episode
     double pass_bonus = 10.0;            // reward per obstacle passed
     // The reference code's Hurdle reward, which its Single baseline trains on (about 600
-    // per curb with pass_bonus 200; docs/reference/tasks.md#hurdle): the speed and
-    // height terms' weights (doubled there), + cross_bonus once each as the trailing foot
-    // (the reference's "rearmost foot", taken as the jump's) passes a curb's start, centre and end,
-    // + mark_upward_weight clip(vz, -2, 2) as the torso passes each of them (WalkerJump's
-    // terms of the same names). Defaults: ours.
+    // per curb with pass_bonus 200 and cross_bonus 200; docs/reference/tasks.md#hurdle):
+    // the speed and height terms' weights (doubled there); once each as the trailing foot
+    // (the reference's "rearmost foot", taken as the jump's) passes a curb's start, centre
+    // and end, cross_bonus x 1/3, 2/3 and 1; and mark_upward_weight clip(vz, -2, 2) as the
+    // torso passes each of them. Defaults: ours.
     double speed_weight = 1.0, height_weight = 1.0;
+    // The height term's weight within ceiling_zone of a ceiling, where the crawl is low
+    // (ours: none; the reference's Obstacle course reward charges it only there, at 2, and
+    // height_weight 0 elsewhere).
+    double ceiling_height_weight = 0.0;
     double cross_bonus = 0.0, mark_upward_weight = 0.0;
     double ceiling_zone = 3.0;           // within this of a ceiling, only a torso below
     double ceiling_fall_height = 0.3;    //   ceiling_fall_height is a fall (crawling is low)

@@ -75,8 +75,9 @@ TEST(Hurdle, CountsEachCurbOnceAtOnePointFiveMetresPastItsEnd) {
   EXPECT_EQ(count, 5);
 }
 
-// The reference code's Hurdle reward (Single's, off by default): the pass and crossing
-// bonuses once per curb, the speed and height terms at their weights, the torso's
+// The reference code's Hurdle reward (Single's, off by default): the pass bonus and the
+// crossing bonuses (a third, two thirds and all of cross_bonus at the curb's start, centre
+// and end) once per curb, the speed and height terms at their weights, the torso's
 // vertical speed as it passes a mark. Each is the difference of two twin envs' rewards.
 TEST(Hurdle, ReferenceRewardTermsByHand) {
   const std::string base = "{position_noise: 0, push_prob: 0";
@@ -85,9 +86,11 @@ TEST(Hurdle, ReferenceRewardTermsByHand) {
   std::vector<float> obs(28);
   reference->reset(0, obs.data());
   ours->reset(0, obs.data());
-  // Teleported past curb 0 (8.0-8.2) + 1.5: its three marks and its pass in one step,
-  // (200 - 10) + 3 x 100; a step further on pays nothing more.
-  for (auto [x, extra] : {std::pair{9.75, 490.0}, std::pair{10.0, 0.0}})
+  // Standing straight, the feet are at the torso's x. Teleported past curb 0's start
+  // (8.0), its centre (8.1), then 1.5 past its end (8.2): 100 / 3, 200 / 3, then 100 and
+  // the pass, 200 - 10, together; a step further on pays nothing more.
+  for (auto [x, extra] : {std::pair{8.05, 100.0 / 3}, std::pair{8.15, 200.0 / 3}, std::pair{9.75, 290.0},
+                          std::pair{10.0, 0.0}})
     EXPECT_NEAR(step_at(*reference, x, obs).reward - step_at(*ours, x, obs).reward, extra, 1e-9) << x;
   // A snapshot carries the marks crossed: restored elsewhere, curb 0 pays nothing again.
   std::vector<double> snapshot;
@@ -161,6 +164,32 @@ TEST(ObstacleCourse, CountsACeilingAtItsOwnPassMargin) {
     // The next curb (19-19.2) still counts at 1.5 m.
     EXPECT_EQ(step_at(*env, 20.65, obs).info.success_count, 1) << margin;
     EXPECT_EQ(step_at(*env, 20.75, obs).info.success_count, 2) << margin;
+  }
+}
+
+// The height term's weight is height_weight away from a ceiling and ceiling_height_weight
+// within ceiling_zone (3 m) of one: at x 6 (2 m before the ceiling at 8) only the second
+// counts, at x 4 only the first.
+TEST(ObstacleCourse, HeightTermWeightNearAndAwayFromACeiling) {
+  const std::string layout =
+      "{position_noise: 0, push_prob: 0, shuffle: false, kinds: [ceiling, curb, curb, curb, ceiling], ";
+  std::vector<float> obs(28);
+  auto reward_at = [&](double x, const std::string& weights, double& delta_h) {
+    auto env = make_task("obstacle_course", layout + weights + "}");
+    env->reset(0, obs.data());
+    const double r = step_at(*env, x, obs).reward;
+    delta_h = dynamic_cast<WalkerCourse&>(*env).delta_h();
+    return r;
+  };
+  double delta_h;
+  for (double x : {6.0, 4.0}) {
+    const bool near = x == 6.0;
+    const double base = reward_at(x, "height_weight: 0, ceiling_height_weight: 0", delta_h);
+    const double away = reward_at(x, "height_weight: 2, ceiling_height_weight: 0", delta_h) - base;
+    const double close = reward_at(x, "height_weight: 0, ceiling_height_weight: 2", delta_h) - base;
+    ASSERT_GT(std::abs(1.1 - delta_h), 0.01) << x;  // the term is not zero here
+    EXPECT_NEAR(near ? close : away, -2 * std::abs(1.1 - delta_h), 1e-9) << x;
+    EXPECT_NEAR(near ? away : close, 0.0, 1e-12) << x;
   }
 }
 
