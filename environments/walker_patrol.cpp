@@ -11,6 +11,8 @@ WalkerPatrol::Config WalkerPatrol::Config::read(const Section& env) {
   c.turn_bonus = env.get("turn_bonus", c.turn_bonus, Range::non_negative());
   c.min_pass_speed = env.get("min_pass_speed", c.min_pass_speed, Range::non_negative());
   c.max_leg_steps = env.get("max_leg_steps", c.max_leg_steps, Range::non_negative());
+  c.speed_weight = env.get("speed_weight", c.speed_weight, Range::non_negative());
+  c.height_weight = env.get("height_weight", c.height_weight, Range::non_negative());
   return c;
 }
 
@@ -39,7 +41,7 @@ void WalkerPatrol::features(double* out) const {
 StepResult WalkerPatrol::evaluate(const float* action) {
   StepResult r;
   double v = x_velocity();
-  r.reward = walk_reward(direction_ * v, action, 1.0, 1.0);
+  r.reward = walk_reward(direction_ * v, action, pcfg_.speed_weight, pcfg_.height_weight);
   ++since_turn_;
   bool too_slow = false;
   if (direction_ * torso_x() > pcfg_.stone_x && direction_ * v < pcfg_.min_pass_speed) {

@@ -24,6 +24,9 @@ class WalkerPatrol : public WalkerEnv {
     // m/s); a leg (from the start or a turn to the next turn) of more control steps ends it (800).
     double min_pass_speed = 0.0;
     int max_leg_steps = 0;  // 0: no limit
+    // The speed and height terms' weights (the reference's Patrol reward, which its Single
+    // baseline trains on, doubles both, with turn_bonus 100). Defaults: ours.
+    double speed_weight = 1.0, height_weight = 1.0;
     static Config read(const Section& env);
   };
   WalkerPatrol(const std::string& name, const WalkerConfig& w, const Config& c);

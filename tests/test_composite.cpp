@@ -284,6 +284,36 @@ TEST(Patrol, TheReferenceRulesEndASlowPassAndALongLeg) {
   EXPECT_EQ(r.info.success_count, 0);
 }
 
+// speed_weight w pays w (3 - |v - 3|) in the current direction, height_weight w charges
+// w |1.1 - delta_h| (the reference's Patrol reward doubles both): each the difference of
+// two twin envs' rewards, walking backward towards the -2 stone after the first turn.
+TEST(Patrol, SpeedAndHeightWeightsByHand) {
+  std::vector<float> obs(27);
+  auto reward = [&](const std::string& weights, double& v, double& delta_h) {
+    auto env = make_task("patrol", "{push_prob: 0, " + weights + "}");
+    auto& patrol = dynamic_cast<WalkerPatrol&>(*env);
+    reset_forward(*env, obs);
+    step_at(*env, 2.2, obs);  // a turn: now heading for -2
+    auto& m = dynamic_cast<MujocoEnv&>(*env);
+    m.mutable_data()->qpos[0] = 0.0;
+    m.mutable_data()->qvel[0] = -2.0;
+    m.forward(obs.data());
+    const double x0 = patrol.torso_x();
+    const double r = env->step(kZero, obs.data()).reward;
+    v = patrol.direction() * (patrol.torso_x() - x0) / 0.008, delta_h = patrol.delta_h();
+    return r;
+  };
+  double v, delta_h;
+  const double speed = reward("speed_weight: 2, height_weight: 0", v, delta_h) -
+                       reward("speed_weight: 1, height_weight: 0", v, delta_h);
+  EXPECT_GT(v, 1.0);  // moving towards the target stone
+  EXPECT_NEAR(speed, 3 - std::abs(v - 3), 1e-9);
+  const double height = reward("speed_weight: 0, height_weight: 2", v, delta_h) -
+                        reward("speed_weight: 0, height_weight: 1", v, delta_h);
+  EXPECT_GT(std::abs(1.1 - delta_h), 0.01);
+  EXPECT_NEAR(height, -std::abs(1.1 - delta_h), 1e-9);
+}
+
 // The reference's composite tasks apply no pushes (prob_apply_force 0); its sub-tasks push
 // with probability 0.2 a step, balance with 0.1.
 TEST(CompositeTasks, PushNothingWhileSubTasksPushAtTheReferenceRates) {
