@@ -294,13 +294,8 @@ TEST(Patrol, SpeedAndHeightWeightsByHand) {
     auto& patrol = dynamic_cast<WalkerPatrol&>(*env);
     reset_forward(*env, obs);
     step_at(*env, 2.2, obs);  // a turn: now heading for -2
-    auto& m = dynamic_cast<MujocoEnv&>(*env);
-    m.mutable_data()->qpos[0] = 0.0;
-    m.mutable_data()->qvel[0] = -2.0;
-    m.forward(obs.data());
-    const double x0 = patrol.torso_x();
-    const double r = env->step(kZero, obs.data()).reward;
-    v = patrol.direction() * (patrol.torso_x() - x0) / 0.008, delta_h = patrol.delta_h();
+    const double r = step_at(*env, 0.0, obs, -2.0).reward;  // from x 0 at 2 m/s towards it
+    v = patrol.direction() * (patrol.torso_x() - 0.0) / 0.008, delta_h = patrol.delta_h();
     return r;
   };
   double v, delta_h;
