@@ -276,7 +276,16 @@ WalkerCrawl::Config WalkerCrawl::Config::read(const Section& env) {
 }
 
 WalkerCrawl::WalkerCrawl(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c)
-    : WalkerObstacleEnv(name, w, o, false), ccfg_(c) {}
+    : WalkerObstacleEnv(name, w, o, false), ccfg_(c) {
+  spec_.feature_names = {"ceiling_ahead", "ceiling_behind"};
+}
+
+void WalkerCrawl::features(double* out) const {
+  const Obstacle* ahead = obstacle_ahead();
+  const Obstacle* behind = obstacle_behind();
+  out[0] = ahead ? ahead->start - min_x() : kFar;
+  out[1] = behind ? min_x() - behind->end : kFar;
+}
 
 void WalkerCrawl::reset_task() {
   set_obstacles({{ObstacleKind::Ceiling, ccfg_.ceiling_start, ccfg_.ceiling_end}});

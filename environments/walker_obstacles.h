@@ -146,6 +146,11 @@ class WalkerCrawl : public WalkerObstacleEnv {
   };
   WalkerCrawl(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
 
+  // Features: ceiling_ahead (metres from x to the ceiling's start, else "far") and
+  // ceiling_behind (metres past its end, else far), as the Obstacle course declares them,
+  // so that a lead-in can hand over to the crawl where that course does.
+  void features(double* out) const override;
+
  protected:
   void reset_task() override;
   StepResult evaluate(const float* action) override;

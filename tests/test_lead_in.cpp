@@ -40,6 +40,30 @@ TEST(LeadIn, JumpFeaturesMeasureTheNearestCurbFromTheRearmostPoint) {
   EXPECT_NEAR(f[0], 3.0 - jump.min_x(), 1e-12);
 }
 
+// The crawl declares the Obstacle course's ceiling features, so the walk can lead into it
+// where that course hands over: measured from the rearmost point, "far" where there is none.
+TEST(LeadIn, WalkLeadsIntoTheCrawlBeforeItsCeiling) {
+  const char* env_keys = "{push_prob: 0, ceiling_start: 8, ceiling_end: 11}";
+  Recipe r = Recipe::parse("lead_in: {policy: " + std::string(kWalk) + ", when: {ceiling_ahead: [2, 3]}}", "lead.yaml");
+  auto crawl = make_task("walker_crawl", env_keys);
+  ASSERT_EQ(crawl->spec().feature_names, (std::vector<std::string>{"ceiling_ahead", "ceiling_behind"}));
+  std::vector<float> obs(crawl->spec().obs_dim);
+  crawl->reset(3, obs.data());
+  const auto& start = dynamic_cast<const WalkerObstacleEnv&>(*crawl);
+  double f[2];
+  crawl->features(f);
+  EXPECT_NEAR(f[0], 8.0 - start.min_x(), 1e-12);
+  EXPECT_EQ(f[1], WalkerObstacleEnv::kFar);
+
+  LeadInEnv env(make_task("walker_crawl", env_keys), LeadIn::read(r.root().sub("lead_in"), crawl->spec()));
+  env.reset(3, obs.data());
+  ASSERT_GT(env.lead_in_steps(), 100);  // the walk covers 5 m of the 8 first
+  env.features(f);
+  EXPECT_GE(f[0], 2.0);
+  EXPECT_LE(f[0], 3.0);
+  EXPECT_EQ(f[1], WalkerObstacleEnv::kFar);
+}
+
 // The hand-over state is one the walk itself passes through: replaying the walk for
 // lead_in_steps() from the same start reproduces it exactly, and it lies in the interval.
 TEST(LeadIn, HandsOverAtAStateOfTheLeadInSkillsOwnRun) {
