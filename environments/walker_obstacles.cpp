@@ -110,6 +110,13 @@ const Obstacle* WalkerObstacleEnv::obstacle_behind() const {
   return nullptr;
 }
 
+void WalkerObstacleEnv::ahead_and_behind(double* out) const {
+  const Obstacle* ahead = obstacle_ahead();
+  const Obstacle* behind = obstacle_behind();
+  out[0] = ahead ? ahead->start - min_x() : kFar;
+  out[1] = behind ? min_x() - behind->end : kFar;
+}
+
 bool WalkerObstacleEnv::touching(int kind) const {
   for (int c = 0; c < data_->ncon; ++c) {
     int k1 = geom_kind_[data_->contact[c].geom1], k2 = geom_kind_[data_->contact[c].geom2];
@@ -188,13 +195,6 @@ WalkerJump::WalkerJump(const std::string& name, const WalkerConfig& w, const Obs
     : WalkerObstacleEnv(name, w, o, true), jcfg_(c) {
   spec_.feature_names = {"curb_ahead", "curb_behind"};
   require_obstacles(size_t(jcfg_.curbs), 0, "curbs");
-}
-
-void WalkerJump::features(double* out) const {
-  const Obstacle* ahead = obstacle_ahead();
-  const Obstacle* behind = obstacle_behind();
-  out[0] = ahead ? ahead->start - min_x() : kFar;
-  out[1] = behind ? min_x() - behind->end : kFar;
 }
 
 void WalkerJump::reset_task() {
@@ -278,13 +278,6 @@ WalkerCrawl::Config WalkerCrawl::Config::read(const Section& env) {
 WalkerCrawl::WalkerCrawl(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c)
     : WalkerObstacleEnv(name, w, o, false), ccfg_(c) {
   spec_.feature_names = {"ceiling_ahead", "ceiling_behind"};
-}
-
-void WalkerCrawl::features(double* out) const {
-  const Obstacle* ahead = obstacle_ahead();
-  const Obstacle* behind = obstacle_behind();
-  out[0] = ahead ? ahead->start - min_x() : kFar;
-  out[1] = behind ? min_x() - behind->end : kFar;
 }
 
 void WalkerCrawl::reset_task() {

@@ -51,6 +51,9 @@ class WalkerObstacleEnv : public WalkerEnv {
   // it (nullptr when there is none): what the tasks' features measure from.
   const Obstacle* obstacle_ahead() const;
   const Obstacle* obstacle_behind() const;
+  // The sub-tasks' two features (a course's own are split by kind): metres from x to the
+  // start of the obstacle ahead, and past the end of the one behind (kFar where none).
+  void ahead_and_behind(double* out) const;
   static constexpr double kFar = 1e6;  // a feature's value when no obstacle is there
   // The three points of a curb crossing bonuses are paid at: its start, centre and end.
   static std::array<double, 3> curb_marks(const Obstacle& c) { return {c.start, 0.5 * (c.start + c.end), c.end}; }
@@ -118,7 +121,7 @@ class WalkerJump : public WalkerObstacleEnv {
   // Features, as Hurdle's: curb_ahead (metres from x to the next curb's start, far when
   // none) and curb_behind (metres past the last curb's end). A skill recipe's lead_in
   // reads them (hrl/lead_in.h).
-  void features(double* out) const override;
+  void features(double* out) const override { ahead_and_behind(out); }
 
  protected:
   void reset_task() override;
@@ -146,10 +149,9 @@ class WalkerCrawl : public WalkerObstacleEnv {
   };
   WalkerCrawl(const std::string& name, const WalkerConfig& w, const ObstacleConfig& o, const Config& c);
 
-  // Features: ceiling_ahead (metres from x to the ceiling's start, else "far") and
-  // ceiling_behind (metres past its end, else far), as the Obstacle course declares them,
-  // so that a lead-in can hand over to the crawl where that course does.
-  void features(double* out) const override;
+  // Features: ceiling_ahead and ceiling_behind (ahead_and_behind), as the Obstacle course
+  // declares them, so that a lead-in can hand over to the crawl where that course does.
+  void features(double* out) const override { ahead_and_behind(out); }
 
  protected:
   void reset_task() override;
