@@ -12,29 +12,51 @@
 
 namespace segue {
 
+double HandOverRates::best_fixed() const { return along.empty() ? 0.0 : *std::max_element(along.begin(), along.end()); }
+
+double HandOverRates::best_fixed_at() const {
+  if (along.size() < 2) return 0.0;
+  return double(std::max_element(along.begin(), along.end()) - along.begin()) / double(along.size() - 1);
+}
+
 HandOverRates handover_rates(SwitchInterval& interval, const Policy* q_ab, int points) {
+  if (points < 2) throw Error("hand-over rates: points must be at least 2 (the interval's start and end)");
   HandOverRates r;
   r.starts = interval.starts();
-  SwitchInterval::Path path;
+  // pi_ab's path from every state first: a path pi_ab fell on is cut short, so its points
+  // are placed on the length of the paths it completed (a fixed point does not know of the
+  // fall to come), and those past the fall are lost.
+  std::vector<SwitchInterval::Path> paths(size_t(r.starts));
+  double completed = 0, length = 0;
+  for (int i = 0; i < r.starts; ++i) {
+    interval.walk(i, q_ab, paths[size_t(i)]);
+    if (!paths[size_t(i)].fell) ++completed, length += double(paths[size_t(i)].states.size() - 1);
+  }
+  if (completed > 0) length /= completed;
   std::vector<int> judged;  // pi_b's outcome from each point: -1 not yet tried
+  r.along.assign(size_t(points), 0.0);
   int q_counted = 0;
   double q_won = 0, q_progress = 0;
-  for (int i = 0; i < interval.starts(); ++i) {
-    interval.walk(i, q_ab, path);
+  for (const SwitchInterval::Path& path : paths) {
     const int last = int(path.states.size()) - 1;
     int q_at = -1;  // q_ab's hand-over: its first switch, else the forced one (+inf)
     for (int k = 0; k < int(path.gap.size()) && q_at < 0; ++k)
       if (path.gap[k] > 0) q_at = k;
     judged.assign(path.states.size(), -1);
     auto judge = [&](int k) {
+      if (k > last) return false;  // pi_ab fell before this point
       if (judged[k] < 0) judged[k] = interval.hand_over_at(path, size_t(k));
       return judged[k] == 1;
     };
     r.at_start += judge(0);
     if (!path.fell) r.at_end += judge(last);
+    const double span = path.fell && completed > 0 ? length : double(last);
     bool won = false;
-    for (int j = 0; j < points && !won; ++j)
-      won |= judge(points == 1 ? 0 : int(std::lround(double(j) * last / (points - 1))));
+    for (int j = 0; j < points; ++j) {
+      const bool ok = judge(int(std::lround(double(j) * span / (points - 1))));
+      r.along[size_t(j)] += ok;
+      won |= ok;
+    }
     if (q_at >= 0) {
       const bool ok = judge(q_at);
       q_won += ok;
@@ -47,6 +69,7 @@ HandOverRates handover_rates(SwitchInterval& interval, const Policy* q_ab, int p
   }
   const double n = std::max(1, r.starts);
   r.at_start /= n, r.at_end /= n, r.oracle /= n, r.fell /= n, r.interval_steps /= n;
+  for (double& a : r.along) a /= n;
   if (q_ab) r.with_q = q_won / n;
   if (q_counted) r.q_progress = q_progress / q_counted;
   return r;
@@ -134,16 +157,18 @@ std::string diagnosis_text(const Diagnosis& d) {
   char line[256];
   o << d.task << ": hand-overs from " << (d.transitions.empty() ? 0 : d.transitions[0].starts)
     << " states of S_a per transition, pi_b judged as in switch training (share that succeed)\n";
-  std::snprintf(line, sizeof line, "  %-22s %9s %8s %10s %11s %11s %10s %9s\n", "transition", "at start", "at end",
-                "with q_ab", "best point", "pi_ab fell", "q_ab at", "interval");
+  std::snprintf(line, sizeof line, "  %-22s %9s %8s %10s %15s %11s %11s %10s %9s\n", "transition", "at start",
+                "at end", "with q_ab", "best fixed (at)", "per state", "pi_ab fell", "q_ab at", "interval");
   o << line;
   for (const HandOverRates& h : d.transitions) {
-    std::snprintf(line, sizeof line, "  %-22s %9.2f %8.2f %10s %11.2f %11.2f %10s %6.0f st\n", h.transition.c_str(),
-                  h.at_start, h.at_end, h.with_q < 0 ? "-" : num(h.with_q, 2).c_str(), h.oracle, h.fell,
-                  h.q_progress < 0 ? "-" : num(h.q_progress, 2).c_str(), h.interval_steps);
+    std::snprintf(line, sizeof line, "  %-22s %9.2f %8.2f %10s %8.2f (%.2f) %11.2f %11.2f %10s %6.0f st\n",
+                  h.transition.c_str(), h.at_start, h.at_end, h.with_q < 0 ? "-" : num(h.with_q, 2).c_str(),
+                  h.best_fixed(), h.best_fixed_at(), h.oracle, h.fell, h.q_progress < 0 ? "-" : num(h.q_progress, 2).c_str(),
+                  h.interval_steps);
     o << line;
   }
-  o << "  (q_ab at: where q_ab hands over, 0 at the interval's start, 1 at its end)\n";
+  o << "  (best fixed: the best of the points along pi_ab's path, the same for every state; per state: the\n"
+       "   best of them for each state, in hindsight; at: where on the interval, 0 its start, 1 its end)\n";
   o << "each skill alone from its own start (its own task, push-free; share that succeed)\n";
   for (const SkillAlone& a : d.skills) {
     if (a.task.empty())
@@ -173,6 +198,10 @@ std::string diagnosis_json(const Diagnosis& d) {
     const HandOverRates& h = d.transitions[i];
     o << (i ? ", " : "") << "{\"transition\": \"" << h.transition << "\", \"starts\": " << h.starts
       << ", \"at_start\": " << num(h.at_start) << ", \"at_end\": " << num(h.at_end) << ", \"with_q\": " << num(h.with_q)
+      << ", \"best_fixed\": " << num(h.best_fixed()) << ", \"best_fixed_at\": " << num(h.best_fixed_at())
+      << ", \"along\": [";
+    for (size_t j = 0; j < h.along.size(); ++j) o << (j ? ", " : "") << num(h.along[j]);
+    o << "]"
       << ", \"oracle\": " << num(h.oracle) << ", \"pi_ab_fell\": " << num(h.fell)
       << ", \"q_progress\": " << num(h.q_progress) << ", \"interval_steps\": " << num(h.interval_steps, 1) << "}";
   }

@@ -7,8 +7,14 @@
 //   at the interval's start       Without TP at the paper's fixed point;
 //   at the interval's end         With TP: pi_ab drives the whole interval;
 //   where q_ab switches           With TP + Q;
-//   at the best of several points along pi_ab's path, in hindsight (q_ab's among them):
-//                                 what a better switch could reach with this pi_ab.
+//   at the best fixed point       the one of several points spread along pi_ab's path
+//                                 (the same share of it for every state) that wins most:
+//                                 what a switch blind to the state could reach;
+//   at the best of those points per state, in hindsight (q_ab's among them): what a
+//                                 switch that foresaw each hand-over's outcome could reach.
+//                                 Where outcomes scatter along the path as chance would,
+//                                 it nears 100% whatever the switch could learn: read it
+//                                 beside the best fixed point.
 // Each skill alone from its own start: its own task (the reference's settings, push-free
 // as the composite tasks run), the success rate of its deterministic policy.
 // And over the method's evaluation episodes (the recipe's seeds, as `segue report` runs
@@ -26,6 +32,11 @@ struct HandOverRates {
   std::string transition;  // "walk-jump"
   int starts = 0;          // S_a states tried
   double at_start = 0, at_end = 0, oracle = 0;
+  std::vector<double> along;  // the rate at each of the oracle's points, in order along pi_ab's path
+  // The best fixed point: the most often won of `along` (the earlier on a tie), and where it
+  // lies on pi_ab's path (0 its start, 1 its end).
+  double best_fixed() const;
+  double best_fixed_at() const;
   double with_q = -1;        // -1: no q_ab
   double q_progress = -1;    // mean step of q_ab's hand-over over the interval's length (0 start, 1 end),
                              // over the starts where pi_ab did not fall
@@ -33,9 +44,11 @@ struct HandOverRates {
   double fell = 0;           // share of starts where pi_ab fell inside the interval
 };
 
-// The rates over every state of `interval`'s S_a; `q_ab` may be null. The oracle tries
-// `points` >= 2 hand-over points spread evenly along pi_ab's path (its start and end among
-// them) and q_ab's, and counts a start as won when any of them succeeds.
+// The rates over every state of `interval`'s S_a; `q_ab` may be null. `points` >= 2
+// hand-over points are spread evenly along pi_ab's path, its start and end among them (on
+// a path pi_ab fell on, along the mean length of the paths it completed, those past the
+// fall lost). The oracle counts a start as won when any of them or q_ab's succeeds; the
+// best fixed point is the one of them with the most wins over all starts.
 HandOverRates handover_rates(SwitchInterval& interval, const Policy* q_ab, int points);
 
 struct SkillAlone {

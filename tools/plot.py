@@ -182,11 +182,12 @@ def diagnosis_chart(path, out):
         raise InputError(f"{path}: cannot read a diagnosis ({e})")
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4), gridspec_kw={"width_ratios": [3, 2]})
     kinds = [("at_start", "at the start (Without TP)", "#BBBBBB"), ("at_end", "at the end (With TP)", "#56B4E9"),
-             ("with_q", "where q_ab switches", "#0072B2"), ("oracle", "best point, in hindsight", "#E69F00")]
+             ("with_q", "where q_ab switches", "#0072B2"), ("best_fixed", "best fixed point", "#009E73"),
+             ("oracle", "best point per state, in hindsight", "#E69F00")]
     width = 0.8 / len(kinds)
     xs = range(len(transitions))
     for i, (key, label, colour) in enumerate(kinds):
-        values = [t[key] if t[key] is not None else math.nan for t in transitions]
+        values = [t[key] if t.get(key) is not None else math.nan for t in transitions]
         left.bar([x - 0.4 + (i + 0.5) * width for x in xs], values, width, label=label, color=colour)
     # pi_b alone from its own start (its own task), where the diagnosis measured it.
     alone = {a["skill"]: a["success"] for a in d.get("skills", []) if a.get("success") is not None}

@@ -15,9 +15,9 @@ const Command kDiagnose{
     "TASK [--method M] [--starts N] [--episodes N] [--json] [--plot FILE.png]",
     "Explains a composite task's results. Per transition, from N states of S_a collected\n"
     "With TP (as segue run collects them), the share of hand-overs after which pi_b achieves its subtask: at the\n"
-    "interval's start (Without TP), at its end (With TP), where q_ab switches (With TP + Q)\n"
-    "and at the best of several points along pi_ab's path, in hindsight (what a better\n"
-    "switch could reach). Each skill alone from its own start: N episodes of its own task\n"
+    "interval's start (Without TP), at its end (With TP), where q_ab switches (With TP + Q),\n"
+    "at the best fixed point of several along pi_ab's path (a switch blind to the state) and\n"
+    "per state at the best of them, in hindsight. Each skill alone from its own start: N episodes of its own task\n"
     "(skills.NAME.task, by default its policy file's name), push-free. Then the method's evaluation episodes (the recipe's eval seeds, as segue report\n"
     "runs them), grouped by who was in control when each ended, at which success count, and\n"
     "how (success, terminated, time limit). Uses the recipe's (by default the shipped) artefacts.",
@@ -25,7 +25,7 @@ const Command kDiagnose{
     {{"method", "M", "method whose episodes are grouped (default tp+q)"},
      {"recipe", "FILE", "composite recipe (default experiments/TASK.yaml)"},
      {"starts", "N", "S_a states per transition, and episodes of each skill alone (default 100)"},
-     {"points", "N", "hand-over points along pi_ab's path the hindsight best tries, >= 2 (default 10)"},
+     {"points", "N", "hand-over points spread along pi_ab's path, >= 2 (default 10)"},
      {"episodes", "N", "evaluation episodes per seed (default: the recipe's eval.episodes)"},
      {"seed", "S", "seed of S_a's collection (default 0)"},
      {"json", "", "print one JSON object instead of the tables"},
