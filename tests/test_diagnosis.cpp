@@ -21,8 +21,8 @@ namespace segue {
 namespace {
 
 // handover_rates by hand: pi_ab's path from each state of S_a, then pi_b from points on it.
-HandOverRates replay(const CompositeRecipe& r, const Policy& pi_ab, const Policy& q_ab, StartStates& starts,
-                     int points) {
+HandOverRates replay(const CompositeRecipe& r, const Policy& pi_ab, const Policy& q_ab,
+                     const StartStates& starts, int points) {
   const Transition& tr = r.meta.transitions()[0];
   const Skill& b = r.skills[tr.to];
   const int max_steps = r.pipeline.switching.max_subtask_steps, n = starts.size();
@@ -152,7 +152,7 @@ TEST_F(TransitionTraining, HandOverRatesMatchAByHandReplay) {
   int fell = 0, completed = 0;
   for (int i = 0; i < many.size() && (fell < 2 || completed < 3); ++i) {
     probe.walk(i, nullptr, path);
-    if (path.fell ? fell++ >= 2 : completed++ >= 3) continue;
+    if (path.fell ? fell++ >= 2 : completed++ >= 3) continue;  // keep two fallen, three completed
     mixed.states.insert(mixed.states.end(), many.states.begin() + size_t(i) * many.state_dim,
                         many.states.begin() + size_t(i + 1) * many.state_dim);
     mixed.obs.insert(mixed.obs.end(), many.obs.begin() + size_t(i) * many.obs_dim,
