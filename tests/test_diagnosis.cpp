@@ -64,7 +64,7 @@ HandOverRates replay(const CompositeRecipe& r, const Policy& pi_ab, const Policy
     }
     if (!w.fell) ++completed, length += double(w.path.size() - 1);
   }
-  length /= std::max(completed, 1.0);
+  if (completed > 0) length /= completed;
   for (Walked& w : walked) {
     const int last = int(w.path.size()) - 1;
     h.interval_steps += w.fell ? w.path.size() : last;  // the forced switch's state is one past pi_ab's last
@@ -77,8 +77,8 @@ HandOverRates replay(const CompositeRecipe& r, const Policy& pi_ab, const Policy
     };
     h.at_start += succeeds(0);
     if (!w.fell) h.at_end += succeeds(last);
-    // A fallen path's points lie along the completed paths' mean length.
-    const double span = w.fell ? length : last;
+    // A fallen path's points lie along the completed paths' mean length (its own if none completed).
+    const double span = w.fell && completed > 0 ? length : last;
     bool won = false;
     for (int j = 0; j < points; ++j) {
       const bool ok = succeeds(int(std::lround(j * span / (points - 1))));
